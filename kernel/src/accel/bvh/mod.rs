@@ -1,0 +1,153 @@
+//! Bounding volume hierarchy over caller-provided memory.
+//!
+//! The caller owns every byte: a node slice sized by [`nodes_needed`] and a primitive-id slice
+//! with one slot per primitive. [`Bvh::build`] fills them (no allocation, no recursion) and
+//! returns a [`Bvh`] that borrows them. Three builders: binned SAH (default), median split
+//! (sort along an axis, split in the middle) and midpoint split (partition at the middle of an
+//! axis, median when that leaves a side empty).
+//!
+//! Depth is capped at [`MAX_DEPTH`]: from depth 32 on, every builder splits at the median, which
+//! halves the count, so no tree is deeper than 32 + 32 levels. Traversal uses a stack of
+//! [`MAX_DEPTH`] entries, so it cannot overflow.
+
+mod build;
+mod node;
+mod select;
+mod traverse;
+mod validate;
+
+pub use node::Node;
+pub use validate::{InvalidTree, TreeStats};
+
+use crate::error::BuildError;
+use crate::geom::Primitive;
+use crate::scalar::Scalar;
+use core::marker::PhantomData;
+
+/// Deepest level a leaf may sit at (the root is level 0). Also the traversal stack capacity.
+pub const MAX_DEPTH: usize = 64;
+/// Depth from which every builder splits at the median, to honour [`MAX_DEPTH`].
+pub const MEDIAN_FALLBACK_DEPTH: usize = MAX_DEPTH - 32;
+/// Largest accepted `max_leaf_size`.
+pub const MAX_LEAF_SIZE: u32 = 64;
+
+/// Exact node slots [`Bvh::build`] needs for `prim_count` primitives: `2n - 1` (0 for none),
+/// the size of a binary tree whose leaves hold one primitive each.
+#[must_use]
+pub const fn nodes_needed(prim_count: usize) -> usize {
+    if prim_count == 0 {
+        0
+    } else {
+        prim_count.saturating_mul(2) - 1
+    }
+}
+
+/// How to choose splits.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum BuilderKind {
+    /// Binned surface area heuristic (32 bins on each axis). Best trees; the default.
+    #[default]
+    Sah,
+    /// Split at the median centroid along the widest axis: balanced, depth `⌈log2(n)⌉`.
+    Median,
+    /// Split at the middle of the widest centroid extent; median when a side would be empty.
+    Midpoint,
+}
+
+impl BuilderKind {
+    /// Every builder, for tests and benchmarks.
+    pub const ALL: [BuilderKind; 3] =
+        [BuilderKind::Sah, BuilderKind::Median, BuilderKind::Midpoint];
+
+    /// Lower-case name as used on command lines: `sah`, `median`, `midpoint`.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Sah => "sah",
+            Self::Median => "median",
+            Self::Midpoint => "midpoint",
+        }
+    }
+}
+
+/// Build settings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct BuildOptions {
+    /// Split strategy.
+    pub builder: BuilderKind,
+    /// No leaf holds more primitives than this (1..=[`MAX_LEAF_SIZE`]).
+    pub max_leaf_size: u32,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        Self {
+            builder: BuilderKind::Sah,
+            max_leaf_size: 4,
+        }
+    }
+}
+
+/// A built BVH, borrowing its nodes, primitive ids and primitives.
+#[derive(Clone, Copy, Debug)]
+pub struct Bvh<'a, S: Scalar, P: Primitive<S>> {
+    nodes: &'a [Node<S>],
+    prim_ids: &'a [u32],
+    prims: &'a [P],
+    depth: u32,
+    _scalar: PhantomData<S>,
+}
+
+impl<'a, S: Scalar, P: Primitive<S>> Bvh<'a, S, P> {
+    /// Builds a BVH over `prims` into `nodes` (at least [`nodes_needed`]`(prims.len())` slots)
+    /// and `prim_ids` (at least `prims.len()` slots). Single-threaded, allocation-free,
+    /// deterministic: the same input gives the same tree on every platform.
+    ///
+    /// # Errors
+    /// [`BuildError::ArenaTooSmall`] with exact sizes, [`BuildError::TooManyPrims`],
+    /// [`BuildError::BadPrimitive`] for the first non-finite or out-of-range vertex, and
+    /// [`BuildError::BadLeafSize`].
+    pub fn build(
+        prims: &'a [P],
+        nodes: &'a mut [Node<S>],
+        prim_ids: &'a mut [u32],
+        options: BuildOptions,
+    ) -> Result<Self, BuildError> {
+        let (node_count, depth) = build::build(prims, nodes, prim_ids, options)?;
+        let nodes: &'a [Node<S>] = nodes;
+        let prim_ids: &'a [u32] = prim_ids;
+        Ok(Self {
+            nodes: nodes.get(..node_count).unwrap_or_default(),
+            prim_ids: prim_ids.get(..prims.len()).unwrap_or_default(),
+            prims,
+            depth,
+            _scalar: PhantomData,
+        })
+    }
+
+    /// The nodes in use (root first).
+    #[must_use]
+    pub fn nodes(&self) -> &'a [Node<S>] {
+        self.nodes
+    }
+    /// Primitive ids in leaf order.
+    #[must_use]
+    pub fn prim_ids(&self) -> &'a [u32] {
+        self.prim_ids
+    }
+    /// The primitives.
+    #[must_use]
+    pub fn prims(&self) -> &'a [P] {
+        self.prims
+    }
+    /// Depth of the deepest leaf (root = 0).
+    #[must_use]
+    pub fn depth(&self) -> u32 {
+        self.depth
+    }
+    /// Bytes of nodes and primitive ids in use (excluding the primitives themselves).
+    #[must_use]
+    pub fn bytes_used(&self) -> usize {
+        core::mem::size_of_val(self.nodes) + core::mem::size_of_val(self.prim_ids)
+    }
+}

@@ -1,0 +1,111 @@
+//! Stack-based traversal, near child first. One routine serves closest hit and any hit.
+
+use super::{Bvh, Node, MAX_DEPTH};
+use crate::accel::{Accel, Counters};
+use crate::geom::{closer, Hit, Primitive, Ray};
+use crate::scalar::Scalar;
+
+impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
+    /// Walks the tree. With `ANY`, returns at the first hit in range; otherwise finds the
+    /// closest under [`closer`]. Returns (t, prim) of the hit, `prim == u32::MAX` for none.
+    #[inline(always)]
+    fn traverse<const ANY: bool, C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> (S, u32) {
+        let rd = ray.data();
+        let t_min = ray.t_min();
+        let mut best_t = ray.t_max();
+        let mut best_prim = u32::MAX;
+        let Some(root) = self.nodes.first() else {
+            return (best_t, best_prim);
+        };
+        stats.node();
+        if S::slab(rd, &root.lo, &root.hi, t_min, best_t).is_none() {
+            return (best_t, best_prim);
+        }
+        // Each level below the root pushes at most one entry, and leaves are at most
+        // MAX_DEPTH deep, so the stack cannot overflow.
+        let mut stack = [(0u32, S::ZERO); MAX_DEPTH];
+        let mut sp = 0usize;
+        let mut node: &Node<S> = root;
+        'walk: loop {
+            if node.count > 0 {
+                let first = node.first as usize;
+                let ids = self
+                    .prim_ids
+                    .get(first..first + node.count as usize)
+                    .unwrap_or_default();
+                for &id in ids {
+                    let Some(prim) = self.prims.get(id as usize) else {
+                        continue;
+                    };
+                    stats.prim();
+                    if let Some(t) = prim.hit_t(rd, t_min, best_t) {
+                        if ANY {
+                            return (t, id);
+                        }
+                        if closer(t, id, best_t, best_prim) {
+                            best_t = t;
+                            best_prim = id;
+                        }
+                    }
+                }
+            } else {
+                let l = node.first as usize;
+                if let (Some(a), Some(b)) = (self.nodes.get(l), self.nodes.get(l + 1)) {
+                    stats.node();
+                    stats.node();
+                    let ta = S::slab(rd, &a.lo, &a.hi, t_min, best_t);
+                    let tb = S::slab(rd, &b.lo, &b.hi, t_min, best_t);
+                    match (ta, tb) {
+                        (Some(ta), Some(tb)) => {
+                            let (near, far, t_far) =
+                                if tb < ta { (b, l, ta) } else { (a, l + 1, tb) };
+                            if let Some(slot) = stack.get_mut(sp) {
+                                *slot = (far as u32, t_far);
+                                sp += 1;
+                            }
+                            node = near;
+                            continue 'walk;
+                        }
+                        (Some(_), None) => {
+                            node = a;
+                            continue 'walk;
+                        }
+                        (None, Some(_)) => {
+                            node = b;
+                            continue 'walk;
+                        }
+                        (None, None) => {}
+                    }
+                }
+            }
+            // Pop the next node still in reach of the current best.
+            loop {
+                if sp == 0 {
+                    break 'walk;
+                }
+                sp -= 1;
+                let (index, t_near) = stack[sp];
+                if t_near <= S::widen(best_t) {
+                    if let Some(n) = self.nodes.get(index as usize) {
+                        node = n;
+                        continue 'walk;
+                    }
+                }
+            }
+        }
+        (best_t, best_prim)
+    }
+}
+
+impl<S: Scalar, P: Primitive<S>> Accel<S> for Bvh<'_, S, P> {
+    fn intersect_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Hit<S>> {
+        let (t, prim) = self.traverse::<false, C>(ray, stats);
+        let p = self.prims.get(prim as usize)?;
+        let (u, v) = p.hit_uv(ray.data());
+        Some(Hit { t, prim, u, v })
+    }
+
+    fn occluded_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> bool {
+        self.traverse::<true, C>(ray, stats).1 != u32::MAX
+    }
+}

@@ -1,0 +1,11 @@
+//! Shared vocabulary: rays, boxes, primitives, hits. Algorithms depend on these, never the reverse.
+
+mod aabb;
+mod hit;
+mod primitive;
+mod ray;
+
+pub use aabb::Aabb;
+pub use hit::{closer, Hit};
+pub use primitive::{Primitive, Sphere, Triangle};
+pub use ray::Ray;

@@ -1,0 +1,89 @@
+use crate::error::RayError;
+use crate::scalar::Scalar;
+
+/// A half-line `origin + t·dir` for `t` in `[t_min, t_max]`, with its precomputed test data.
+///
+/// The direction is normalised by the constructors, so `t` is a distance in both modes.
+/// Invariant: `0 <= t_min <= t_max`, `t_min` finite, no NaN anywhere; the precomputed data
+/// (inverse direction, shear) never holds NaN.
+#[derive(Clone, Copy, Debug)]
+pub struct Ray<S: Scalar> {
+    data: S::RayData,
+    t_min: S,
+    t_max: S,
+}
+
+impl<S: Scalar> Ray<S> {
+    /// A ray over `[0, S::FAR]`.
+    ///
+    /// # Errors
+    /// [`RayError::Origin`] for a non-finite or out-of-range origin, [`RayError::ZeroDirection`]
+    /// and [`RayError::NonFiniteDirection`] for an unusable direction.
+    pub fn new(origin: S::Vec3, dir: S::Vec3) -> Result<Self, RayError> {
+        let data = S::ray_data(S::vec_to_array(origin), S::vec_to_array(dir))?;
+        Ok(Self {
+            data,
+            t_min: S::ZERO,
+            t_max: S::FAR,
+        })
+    }
+
+    /// A ray from `f32` components over `[t_min, t_max]` (`t_max` may be `+inf`; fixed point
+    /// saturates it). In fixed-point mode the direction keeps 30 fraction bits.
+    ///
+    /// # Errors
+    /// As [`Ray::new`], plus [`RayError::InvalidInterval`].
+    pub fn from_f32(
+        origin: [f32; 3],
+        dir: [f32; 3],
+        t_min: f32,
+        t_max: f32,
+    ) -> Result<Self, RayError> {
+        if !(t_min >= 0.0 && t_min.is_finite() && t_max >= t_min) {
+            return Err(RayError::InvalidInterval);
+        }
+        let data = S::ray_data_from_f32(origin, dir)?;
+        Ok(Self {
+            data,
+            t_min: S::from_f32_saturating(t_min),
+            t_max: S::from_f32_saturating(t_max),
+        })
+    }
+
+    /// The same ray over `[t_min, t_max]`.
+    ///
+    /// # Errors
+    /// [`RayError::InvalidInterval`] unless `0 <= t_min <= t_max` with `t_min` finite.
+    pub fn with_interval(self, t_min: S, t_max: S) -> Result<Self, RayError> {
+        let finite = t_min < S::FAR || t_min == S::ZERO;
+        if !(t_min >= S::ZERO && finite && t_max >= t_min) {
+            return Err(RayError::InvalidInterval);
+        }
+        Ok(Self {
+            t_min,
+            t_max,
+            ..self
+        })
+    }
+
+    /// Origin.
+    pub fn origin(&self) -> S::Vec3 {
+        S::array_to_vec(S::ray_origin(&self.data))
+    }
+    /// Unit direction (rounded to `S`; fixed point keeps more bits internally).
+    pub fn dir(&self) -> S::Vec3 {
+        S::array_to_vec(S::ray_dir(&self.data))
+    }
+    /// Start of the interval.
+    pub fn t_min(&self) -> S {
+        self.t_min
+    }
+    /// End of the interval.
+    pub fn t_max(&self) -> S {
+        self.t_max
+    }
+    /// Precomputed test data, for primitive implementations.
+    pub fn data(&self) -> &S::RayData {
+        &self.data
+    }
+}

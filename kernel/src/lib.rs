@@ -1,0 +1,45 @@
+//! A ray-tracing kernel for anything from a Cortex-M0 to a workstation, giving the same bits on
+//! every one of them.
+//!
+//! - `#![no_std]`, no allocator, no recursion, no panics on bad input: the caller hands over the
+//!   memory (node arena, primitive-id buffer) and gets typed errors for bad data.
+//! - Two number modes with one set of algorithms: `f32` (API in `glam::Vec3`) and the
+//!   fixed-point [`I16F16`] (Q16.16 coordinates, Q2.30 unit directions, exact integer tests).
+//! - A BVH built into caller memory by one of three builders (binned SAH, median, midpoint),
+//!   traversed with a fixed stack sized from the depth cap, near child first.
+//! - Watertight ray/triangle tests (Woop, Benthin, Wald 2013 in `f32`; exact integer edge
+//!   functions in fixed point) and a conservative slab test (Ize 2013), so rays through shared
+//!   edges and vertices never slip through and traversal never culls a box it should enter.
+//! - Closest-hit ties go to the lowest primitive id, so every accelerator returns the same hit
+//!   as brute force ([`Linear`]), bit for bit.
+//!
+//! ```
+//! use raykernel::{bvh::{nodes_needed, BuildOptions}, Accel, Bvh, Node, Ray, Triangle};
+//! use glam::Vec3;
+//!
+//! const N: usize = 2;
+//! let tris: [Triangle<f32>; N] = [
+//!     Triangle::new(Vec3::new(-1.0, -1.0, 5.0), Vec3::new(1.0, -1.0, 5.0), Vec3::new(0.0, 1.0, 5.0)),
+//!     Triangle::new(Vec3::new(-1.0, -1.0, 9.0), Vec3::new(1.0, -1.0, 9.0), Vec3::new(0.0, 1.0, 9.0)),
+//! ];
+//! let mut nodes = [Node::EMPTY; nodes_needed(N)];
+//! let mut ids = [0u32; N];
+//! let bvh = Bvh::build(&tris, &mut nodes, &mut ids, BuildOptions::default()).unwrap();
+//! let hit = bvh.intersect(&Ray::new(Vec3::ZERO, Vec3::Z).unwrap()).unwrap();
+//! assert_eq!((hit.t, hit.prim), (5.0, 0));
+//! ```
+#![no_std]
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod accel;
+pub mod error;
+pub mod geom;
+pub mod scalar;
+
+pub use accel::bvh::{self, Bvh, Node};
+pub use accel::{Accel, Counters, Linear, NoStats, TraversalStats};
+pub use error::{Arena, BuildError, PointError, RayError};
+pub use geom::{Aabb, Hit, Primitive, Ray, Sphere, Triangle};
+pub use glam;
+pub use scalar::{Scalar, Vec3x, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16};

@@ -1,0 +1,464 @@
+//! Fixed-point mode: [`I16F16`] coordinates, Q2.30 unit directions, exact integer tests.
+//!
+//! Widths (raw integers, `b` = bits of magnitude):
+//! - coordinates: Q16.16 in `i32`, limited to `|x| <= 8192` (raw `<= 2^29`), so a difference of
+//!   two points fits 31 bits and every in-scene distance (`<= 8192·2·√3 < 32768`) fits Q16.16;
+//! - directions: unit length in Q2.30 (raw `|d| <= 2^30`);
+//! - triangle edge functions `U = C'·(B'×D)`: `B'×D` is `< 2^61` in `i64`, the dot is `< 2^93` in
+//!   `i128`, so the signs are exact: shared edges and vertices are never missed or hit twice
+//!   by a gap (no fallback needed, unlike `f32`);
+//! - hit distance: `t = floor(T·2^30 / det)` in `i128` (deterministic, not exact);
+//! - slab test: `(plane - origin) · (2^62 / d) >> 32` in `i128`, padded by 2 raw units each way,
+//!   which bounds the rounding of the reciprocal, so boxes are never culled wrongly.
+
+use super::Scalar;
+use crate::error::{PointError, RayError};
+use core::ops::{Add, Div, Mul, Neg, Sub};
+
+/// A signed fixed-point number with 16 integer and 16 fraction bits (`value = raw / 65536`).
+///
+/// Range `[-32768, 32768)` with resolution `2^-16 ≈ 1.5e-5`. Arithmetic operators
+/// **saturate** at the range ends (never wrap, never panic); multiplication and division round
+/// to nearest, ties away from zero. Kernel geometry is further limited to
+/// [`FIXED_COORD_LIMIT`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[repr(transparent)]
+pub struct I16F16(pub i32);
+
+/// Largest coordinate magnitude (world units) accepted in fixed-point mode: 8192 = 2^13.
+pub const FIXED_COORD_LIMIT: f32 = 8192.0;
+const LIMIT_RAW: i32 = 1 << 29;
+const ONE_RAW: i32 = 1 << 16;
+/// Raw value of 1.0 in Q2.30.
+const DIR_ONE: f64 = (1u64 << 30) as f64;
+/// Slab padding in raw units; bounds the error of the rounded reciprocal (< 2 raw units).
+const SLAB_PAD: i64 = 2;
+
+impl I16F16 {
+    /// 0.
+    pub const ZERO: Self = Self(0);
+    /// 1.
+    pub const ONE: Self = Self(ONE_RAW);
+    /// Largest value, `32768 - 2^-16`.
+    pub const MAX: Self = Self(i32::MAX);
+    /// Smallest value, `-32768`.
+    pub const MIN: Self = Self(i32::MIN);
+
+    /// From raw bits.
+    #[must_use]
+    pub const fn from_raw(raw: i32) -> Self {
+        Self(raw)
+    }
+    /// Raw bits.
+    #[must_use]
+    pub const fn raw(self) -> i32 {
+        self.0
+    }
+    /// From an integer, saturating.
+    #[must_use]
+    pub const fn from_int(x: i32) -> Self {
+        Self(x.saturating_mul(ONE_RAW))
+    }
+    /// Rounds `x` to nearest (ties away from zero), saturating; NaN gives zero.
+    #[must_use]
+    pub fn from_f32(x: f32) -> Self {
+        // f64 holds x·65536 exactly; `as i32` saturates and maps NaN to 0.
+        Self(libm::round(x as f64 * ONE_RAW as f64) as i32)
+    }
+    /// Converts to `f32`, rounding to nearest (exact when `|raw| < 2^24`).
+    #[must_use]
+    pub fn to_f32(self) -> f32 {
+        (self.0 as f64 / ONE_RAW as f64) as f32
+    }
+}
+
+fn saturate(x: i64) -> I16F16 {
+    I16F16(if x > i32::MAX as i64 {
+        i32::MAX
+    } else if x < i32::MIN as i64 {
+        i32::MIN
+    } else {
+        x as i32
+    })
+}
+
+/// `round(n / d)` for `d > 0`, ties away from zero.
+fn div_round(n: i128, d: i128) -> i128 {
+    let half = d / 2;
+    if n >= 0 {
+        (n + half) / d
+    } else {
+        -((-n + half) / d)
+    }
+}
+
+impl Add for I16F16 {
+    type Output = Self;
+    fn add(self, o: Self) -> Self {
+        Self(self.0.saturating_add(o.0))
+    }
+}
+impl Sub for I16F16 {
+    type Output = Self;
+    fn sub(self, o: Self) -> Self {
+        Self(self.0.saturating_sub(o.0))
+    }
+}
+impl Neg for I16F16 {
+    type Output = Self;
+    fn neg(self) -> Self {
+        Self(self.0.saturating_neg())
+    }
+}
+impl Mul for I16F16 {
+    type Output = Self;
+    fn mul(self, o: Self) -> Self {
+        saturate(div_round(self.0 as i128 * o.0 as i128, ONE_RAW as i128) as i64)
+    }
+}
+impl Div for I16F16 {
+    type Output = Self;
+    /// Division by zero saturates to `MAX`/`MIN` by the sign of the dividend (zero for 0/0).
+    fn div(self, o: Self) -> Self {
+        if o.0 == 0 {
+            return match self.0 {
+                0 => Self::ZERO,
+                x if x > 0 => Self::MAX,
+                _ => Self::MIN,
+            };
+        }
+        let (n, d) = ((self.0 as i128) << 16, o.0 as i128);
+        let q = if d > 0 {
+            div_round(n, d)
+        } else {
+            div_round(-n, -d)
+        };
+        saturate(q.clamp(i64::MIN as i128, i64::MAX as i128) as i64)
+    }
+}
+
+/// A point or vector of [`I16F16`], the public vector type of fixed-point mode.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Vec3x {
+    /// x.
+    pub x: I16F16,
+    /// y.
+    pub y: I16F16,
+    /// z.
+    pub z: I16F16,
+}
+
+impl Vec3x {
+    /// From components.
+    #[must_use]
+    pub const fn new(x: I16F16, y: I16F16, z: I16F16) -> Self {
+        Self { x, y, z }
+    }
+    /// Rounds each `f32` component (see [`I16F16::from_f32`]).
+    #[must_use]
+    pub fn from_f32(v: [f32; 3]) -> Self {
+        Self::new(
+            I16F16::from_f32(v[0]),
+            I16F16::from_f32(v[1]),
+            I16F16::from_f32(v[2]),
+        )
+    }
+    /// Components as `f32`.
+    #[must_use]
+    pub fn to_f32(self) -> [f32; 3] {
+        [self.x.to_f32(), self.y.to_f32(), self.z.to_f32()]
+    }
+}
+
+/// Per-ray data for fixed-point mode. Built only by [`crate::Ray`]'s constructors.
+#[derive(Clone, Copy, Debug)]
+pub struct FixedRay {
+    /// Origin, raw Q16.16.
+    origin: [i64; 3],
+    /// Unit direction, raw Q2.30.
+    dir: [i64; 3],
+    /// `2^62 / dir` truncated (`i64::MAX` for a zero component).
+    recip: [i64; 3],
+    /// Origin moved one raw unit so near distances are never overestimated.
+    o_near: [i64; 3],
+    /// Origin moved one raw unit so far distances are never underestimated.
+    o_far: [i64; 3],
+    /// Per axis: the direction is negative, so the near plane is the box's `hi`.
+    neg: [bool; 3],
+}
+
+fn check_raw(x: i32) -> Result<(), PointError> {
+    if x.unsigned_abs() > LIMIT_RAW as u32 {
+        Err(PointError::OutOfRange {
+            limit: FIXED_COORD_LIMIT,
+        })
+    } else {
+        Ok(())
+    }
+}
+
+impl FixedRay {
+    fn new(origin: [I16F16; 3], unit: [f64; 3]) -> Result<Self, RayError> {
+        for x in origin {
+            check_raw(x.0).map_err(RayError::Origin)?;
+        }
+        let mut r = Self {
+            origin: [0; 3],
+            dir: [0; 3],
+            recip: [0; 3],
+            o_near: [0; 3],
+            o_far: [0; 3],
+            neg: [false; 3],
+        };
+        for i in 0..3 {
+            let o = origin[i].0 as i64;
+            let d = libm::round(unit[i] * DIR_ONE) as i64;
+            let s = if d < 0 { -1 } else { 1 };
+            r.origin[i] = o;
+            r.dir[i] = d;
+            r.recip[i] = if d == 0 { i64::MAX } else { (1i64 << 62) / d };
+            r.neg[i] = d < 0;
+            r.o_near[i] = o + s;
+            r.o_far[i] = o - s;
+        }
+        Ok(r)
+    }
+
+    #[inline(always)]
+    fn rel(&self, v: &[I16F16; 3]) -> [i64; 3] {
+        [
+            v[0].0 as i64 - self.origin[0],
+            v[1].0 as i64 - self.origin[1],
+            v[2].0 as i64 - self.origin[2],
+        ]
+    }
+
+    /// `p × dir`; each component `< 2^61`.
+    #[inline(always)]
+    fn cross_dir(&self, p: &[i64; 3]) -> [i64; 3] {
+        let d = &self.dir;
+        [
+            p[1] * d[2] - p[2] * d[1],
+            p[2] * d[0] - p[0] * d[2],
+            p[0] * d[1] - p[1] * d[0],
+        ]
+    }
+
+    /// Exact edge functions (U, V, W) and the vertices relative to the origin.
+    #[inline(always)]
+    fn edges(&self, v: &[[I16F16; 3]; 3]) -> ([i128; 3], [[i64; 3]; 3]) {
+        let (a, b, c) = (self.rel(&v[0]), self.rel(&v[1]), self.rel(&v[2]));
+        let (ad, bd, cd) = (self.cross_dir(&a), self.cross_dir(&b), self.cross_dir(&c));
+        ([dot(&c, &bd), dot(&a, &cd), dot(&b, &ad)], [a, b, c])
+    }
+}
+
+#[inline(always)]
+fn dot(p: &[i64; 3], q: &[i64; 3]) -> i128 {
+    p[0] as i128 * q[0] as i128 + p[1] as i128 * q[1] as i128 + p[2] as i128 * q[2] as i128
+}
+
+/// Range check on a raw distance (`i128`) and conversion to `I16F16`.
+fn t_in_range(t: i128, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
+    if t >= t_min.0 as i128 && t <= t_max.0 as i128 {
+        Some(I16F16(t as i32))
+    } else {
+        None
+    }
+}
+
+impl Scalar for I16F16 {
+    type Vec3 = Vec3x;
+    type RayData = FixedRay;
+
+    const ZERO: Self = Self(0);
+    const FAR: Self = Self::MAX;
+    const NAME: &'static str = "fixed";
+
+    fn to_f32(self) -> f32 {
+        I16F16::to_f32(self)
+    }
+    fn from_f32_saturating(x: f32) -> Self {
+        I16F16::from_f32(x)
+    }
+    fn coord_from_f32(x: f32) -> Result<Self, PointError> {
+        if !x.is_finite() {
+            return Err(PointError::NonFinite);
+        }
+        let v = I16F16::from_f32(x);
+        check_raw(v.0).map(|()| v)
+    }
+    fn vec_to_array(v: Vec3x) -> [Self; 3] {
+        [v.x, v.y, v.z]
+    }
+    fn array_to_vec(a: [Self; 3]) -> Vec3x {
+        Vec3x::new(a[0], a[1], a[2])
+    }
+    fn check_point(p: [Self; 3]) -> Result<(), PointError> {
+        p.iter().try_for_each(|x| check_raw(x.0))
+    }
+    fn check_radius(r: Self) -> Result<(), PointError> {
+        if r.0 < 0 {
+            Err(PointError::NegativeRadius)
+        } else {
+            check_raw(r.0)
+        }
+    }
+
+    fn ray_data(origin: [Self; 3], dir: [Self; 3]) -> Result<FixedRay, RayError> {
+        let unit = super::float::unit_dir_f64([dir[0].0 as f64, dir[1].0 as f64, dir[2].0 as f64])?;
+        FixedRay::new(origin, unit)
+    }
+    fn ray_data_from_f32(origin: [f32; 3], dir: [f32; 3]) -> Result<FixedRay, RayError> {
+        let mut o = [I16F16::ZERO; 3];
+        for i in 0..3 {
+            o[i] = Self::coord_from_f32(origin[i]).map_err(RayError::Origin)?;
+        }
+        let unit = super::float::unit_dir_f64([dir[0] as f64, dir[1] as f64, dir[2] as f64])?;
+        FixedRay::new(o, unit)
+    }
+    fn ray_origin(ray: &FixedRay) -> [Self; 3] {
+        ray.origin.map(|x| I16F16(x as i32))
+    }
+    fn ray_dir(ray: &FixedRay) -> [Self; 3] {
+        // Q2.30 -> Q16.16, rounded.
+        ray.dir.map(|d| I16F16(((d + (1 << 13)) >> 14) as i32))
+    }
+
+    fn pad_bounds(lo: [Self; 3], hi: [Self; 3]) -> ([Self; 3], [Self; 3]) {
+        (lo, hi)
+    }
+
+    #[inline(always)]
+    fn slab(
+        r: &FixedRay,
+        lo: &[Self; 3],
+        hi: &[Self; 3],
+        t_min: Self,
+        t_max: Self,
+    ) -> Option<Self> {
+        let mut t_near = t_min.0 as i64;
+        let mut t_far = t_max.0 as i64 + SLAB_PAD;
+        for i in 0..3 {
+            let (near, far) = if r.neg[i] {
+                (hi[i].0, lo[i].0)
+            } else {
+                (lo[i].0, hi[i].0)
+            };
+            let tn = (((near as i64 - r.o_near[i]) as i128 * r.recip[i] as i128) >> 32) as i64;
+            let tf = (((far as i64 - r.o_far[i]) as i128 * r.recip[i] as i128) >> 32) as i64;
+            t_near = t_near.max(tn - SLAB_PAD);
+            t_far = t_far.min(tf + SLAB_PAD);
+        }
+        // t_near <= t_far <= t_max + pad, and t_near >= t_min >= 0: fits after the clamp.
+        if t_near <= t_far {
+            Some(I16F16(t_near.min(i32::MAX as i64) as i32))
+        } else {
+            None
+        }
+    }
+
+    #[inline(always)]
+    fn widen(t: Self) -> Self {
+        I16F16(t.0.saturating_add(SLAB_PAD as i32))
+    }
+
+    #[inline(always)]
+    fn triangle_t(r: &FixedRay, v: &[[Self; 3]; 3], t_min: Self, t_max: Self) -> Option<Self> {
+        let ([eu, ev, ew], [a, b, c]) = r.edges(v);
+        if (eu < 0 || ev < 0 || ew < 0) && (eu > 0 || ev > 0 || ew > 0) {
+            return None;
+        }
+        let mut det = eu + ev + ew;
+        if det == 0 {
+            return None;
+        }
+        // T = A'·(C'×B'): t = T / det in units of the Q2.30 direction.
+        let cb = [
+            c[1] * b[2] - c[2] * b[1],
+            c[2] * b[0] - c[0] * b[2],
+            c[0] * b[1] - c[1] * b[0],
+        ];
+        let mut tt = dot(&a, &cb);
+        if det < 0 {
+            det = -det;
+            tt = -tt;
+        }
+        if tt < 0 {
+            return None;
+        }
+        // Raw Q16.16 t = T·2^48-scale / det·2^62-scale · 2^16 = T·2^30 / det; T < 2^93.
+        t_in_range((tt << 30) / det, t_min, t_max)
+    }
+
+    fn triangle_uv(r: &FixedRay, v: &[[Self; 3]; 3]) -> (Self, Self) {
+        let ([eu, ev, ew], _) = r.edges(v);
+        let det = eu + ev + ew;
+        if det == 0 {
+            return (Self::ZERO, Self::ZERO);
+        }
+        let q = |e: i128| {
+            let (n, d) = if det < 0 { (-e, -det) } else { (e, det) };
+            I16F16(((n << 16) / d).clamp(0, ONE_RAW as i128) as i32)
+        };
+        (q(ev), q(ew))
+    }
+
+    fn sphere_t(
+        r: &FixedRay,
+        center: &[Self; 3],
+        radius: Self,
+        t_min: Self,
+        t_max: Self,
+    ) -> Option<Self> {
+        // |L + t·D|² = R² with L = O - C (scale 2^16) and D (scale 2^30):
+        // a t² + 2 b t + c = 0 with a = D·D (2^60), b = L·D (2^46), c = L·L - R² (2^32).
+        let l = [
+            r.origin[0] - center[0].0 as i64,
+            r.origin[1] - center[1].0 as i64,
+            r.origin[2] - center[2].0 as i64,
+        ];
+        let a = dot(&r.dir, &r.dir);
+        let b = dot(&l, &r.dir);
+        let c = dot(&l, &l) - radius.0 as i128 * radius.0 as i128;
+        let disc = b * b - a * c; // scale 2^92, < 2^125
+        if disc < 0 || a == 0 {
+            return None;
+        }
+        let s = disc.unsigned_abs().isqrt() as i128; // scale 2^46
+                                                     // t (raw Q16.16) = (-b ∓ s) · 2^30 / a, floored.
+        let near = ((-b - s) << 30).div_euclid(a);
+        let far = ((-b + s) << 30).div_euclid(a);
+        t_in_range(near, t_min, t_max).or_else(|| t_in_range(far, t_min, t_max))
+    }
+
+    fn sphere_bounds(center: &[Self; 3], radius: Self) -> ([Self; 3], [Self; 3]) {
+        (center.map(|c| c - radius), center.map(|c| c + radius))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn arithmetic_rounds_and_saturates() {
+        let f = I16F16::from_f32;
+        assert_eq!(f(1.5) * f(2.0), f(3.0));
+        assert_eq!(f(1.0) / f(3.0), I16F16(21845));
+        assert_eq!(I16F16::MAX + I16F16::ONE, I16F16::MAX);
+        assert_eq!(I16F16::MIN - I16F16::ONE, I16F16::MIN);
+        assert_eq!(-I16F16::MIN, I16F16::MAX);
+        assert_eq!(f(20000.0) * f(20000.0), I16F16::MAX);
+        assert_eq!(f(1.0) / I16F16::ZERO, I16F16::MAX);
+        assert_eq!(f(f32::NAN), I16F16::ZERO);
+        assert_eq!(f(-2.5).to_f32(), -2.5);
+    }
+
+    #[test]
+    fn unit_directions_use_thirty_fraction_bits() {
+        let r = FixedRay::new([I16F16::ZERO; 3], [0.6, 0.8, 0.0]).unwrap();
+        assert_eq!(r.dir, [644_245_094, 858_993_459, 0]);
+        assert_eq!(r.recip[2], i64::MAX);
+    }
+}

@@ -1,0 +1,390 @@
+//! `f32` mode: conservative slab test (Ize 2013) and watertight ray/triangle test
+//! (Woop, Benthin, Wald 2013, "Watertight Ray/Triangle Intersection", JCGT 2(1)).
+//!
+//! Rounding rules: only `+ - * /` and `libm::sqrtf`/`libm::sqrt` (correctly rounded everywhere),
+//! no fused multiply-add, min/max as explicit comparisons. Every function is a pure function of
+//! its inputs, so a primitive gives the same bits whichever accelerator asks.
+
+use super::Scalar;
+use crate::error::{PointError, RayError};
+
+/// Largest coordinate magnitude accepted in `f32` mode (2^40, about 1.1e12). Beyond it the
+/// triple products of the triangle test could overflow to infinity and silently lose hits.
+pub const F32_COORD_LIMIT: f32 = 1_099_511_627_776.0;
+
+/// Relative margin of the slab test and of node padding (2^-19). It covers the rounding of the
+/// slab arithmetic (Ize's 1 + 2γ₃ is about 3.6e-7) and the lateral rounding of the triangle
+/// test's shear (a few ulps of the largest coordinate), with room to spare.
+const MARGIN: f32 = 1.0 / 524_288.0;
+
+/// Per-ray data for `f32` mode. Built only by [`crate::Ray`]'s constructors.
+#[derive(Clone, Copy, Debug)]
+pub struct FloatRay {
+    origin: [f32; 3],
+    /// Unit direction.
+    dir: [f32; 3],
+    /// `1 / dir`, `±inf` for `±0` components (sign preserved, never NaN).
+    inv: [f32; 3],
+    /// Origin moved so the near plane distance is never overestimated.
+    o_near: [f32; 3],
+    /// Origin moved so the far plane distance is never underestimated.
+    o_far: [f32; 3],
+    /// Per axis: the direction's sign bit is set, so the near plane is the box's `hi`.
+    neg: [bool; 3],
+    /// Watertight test: axis permutation (kx, ky, kz), each < 3; kept as indices into `[f32; 4]`.
+    k: [usize; 3],
+    /// Watertight test: shear constants Sx, Sy, Sz.
+    shear: [f32; 3],
+}
+
+fn abs(x: f32) -> f32 {
+    libm::fabsf(x)
+}
+
+/// The next representable value above (`up`) or below `x`; `x` must be finite.
+fn step(x: f32, up: bool) -> f32 {
+    if x == 0.0 {
+        let tiny = f32::from_bits(1);
+        return if up { tiny } else { -tiny };
+    }
+    let bits = x.to_bits();
+    let away_from_zero = (x > 0.0) == up;
+    f32::from_bits(if away_from_zero { bits + 1 } else { bits - 1 })
+}
+
+/// `x` moved by `delta` in the given direction, and by at least one ulp.
+fn shift(x: f32, delta: f32, up: bool) -> f32 {
+    let y = if up { x + delta } else { x - delta };
+    if y == x {
+        step(x, up)
+    } else {
+        y
+    }
+}
+
+fn check_coord(x: f32) -> Result<(), PointError> {
+    if !x.is_finite() {
+        Err(PointError::NonFinite)
+    } else if abs(x) > F32_COORD_LIMIT {
+        Err(PointError::OutOfRange {
+            limit: F32_COORD_LIMIT,
+        })
+    } else {
+        Ok(())
+    }
+}
+
+/// Unit vector along `d`, computed in `f64` after scaling by the largest component so that
+/// neither overflow nor underflow can occur.
+pub(super) fn unit_dir_f64(d: [f64; 3]) -> Result<[f64; 3], RayError> {
+    if !(d[0].is_finite() && d[1].is_finite() && d[2].is_finite()) {
+        return Err(RayError::NonFiniteDirection);
+    }
+    let m = libm::fmax(
+        libm::fabs(d[0]),
+        libm::fmax(libm::fabs(d[1]), libm::fabs(d[2])),
+    );
+    if m == 0.0 {
+        return Err(RayError::ZeroDirection);
+    }
+    let s = [d[0] / m, d[1] / m, d[2] / m];
+    let len = libm::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    Ok([s[0] / len, s[1] / len, s[2] / len])
+}
+
+impl FloatRay {
+    fn new(origin: [f32; 3], dir: [f32; 3]) -> Result<Self, RayError> {
+        for &x in &origin {
+            check_coord(x).map_err(RayError::Origin)?;
+        }
+        let d64 = unit_dir_f64([dir[0] as f64, dir[1] as f64, dir[2] as f64])?;
+        let dir = [d64[0] as f32, d64[1] as f32, d64[2] as f32];
+
+        let o_max = abs(origin[0]).max_of(abs(origin[1])).max_of(abs(origin[2]));
+        let delta = o_max * MARGIN;
+        let mut inv = [0.0; 3];
+        let mut neg = [false; 3];
+        let mut o_near = [0.0; 3];
+        let mut o_far = [0.0; 3];
+        for i in 0..3 {
+            inv[i] = 1.0 / dir[i];
+            neg[i] = dir[i].is_sign_negative();
+            // Moving the origin towards +dir makes near distances smaller; away, far ones larger.
+            o_near[i] = shift(origin[i], delta, !neg[i]);
+            o_far[i] = shift(origin[i], delta, neg[i]);
+        }
+
+        // Watertight test: kz is the dominant axis; swapping kx/ky keeps the winding.
+        let a = [abs(dir[0]), abs(dir[1]), abs(dir[2])];
+        let kz = if a[0] >= a[1] && a[0] >= a[2] {
+            0
+        } else if a[1] >= a[2] {
+            1
+        } else {
+            2
+        };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        if dir[kz] < 0.0 {
+            core::mem::swap(&mut kx, &mut ky);
+        }
+        let shear = [dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]];
+        Ok(Self {
+            origin,
+            dir,
+            inv,
+            o_near,
+            o_far,
+            neg,
+            k: [kx, ky, kz],
+            shear,
+        })
+    }
+
+    /// Vertex relative to the origin, padded to 4 lanes so `k & 3` indexes without a check.
+    #[inline(always)]
+    fn rel(&self, v: &[f32; 3]) -> [f32; 4] {
+        [
+            v[0] - self.origin[0],
+            v[1] - self.origin[1],
+            v[2] - self.origin[2],
+            0.0,
+        ]
+    }
+
+    /// Sheared 2D coordinates and scaled z of a vertex: the ray becomes the +z axis.
+    #[inline(always)]
+    fn shear(&self, v: &[f32; 3]) -> [f32; 3] {
+        let p = self.rel(v);
+        let [kx, ky, kz] = [self.k[0] & 3, self.k[1] & 3, self.k[2] & 3];
+        let [sx, sy, sz] = self.shear;
+        [p[kx] - sx * p[kz], p[ky] - sy * p[kz], sz * p[kz]]
+    }
+
+    /// The three edge functions (U, V, W) of the sheared triangle, with the exact `f64`
+    /// recomputation when any is zero (f32 products are exact in f64, so the sign is exact).
+    #[inline(always)]
+    fn edges(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> [f32; 3] {
+        let u = c[0] * b[1] - c[1] * b[0];
+        let v = a[0] * c[1] - a[1] * c[0];
+        let w = b[0] * a[1] - b[1] * a[0];
+        if u == 0.0 || v == 0.0 || w == 0.0 {
+            let f = |p: &[f32; 3], q: &[f32; 3]| {
+                (p[0] as f64 * q[1] as f64 - p[1] as f64 * q[0] as f64) as f32
+            };
+            return [f(c, b), f(a, c), f(b, a)];
+        }
+        [u, v, w]
+    }
+}
+
+impl Scalar for f32 {
+    type Vec3 = glam::Vec3;
+    type RayData = FloatRay;
+
+    const ZERO: Self = 0.0;
+    const FAR: Self = f32::INFINITY;
+    const NAME: &'static str = "f32";
+
+    fn to_f32(self) -> f32 {
+        self
+    }
+    fn from_f32_saturating(x: f32) -> Self {
+        if x.is_nan() {
+            0.0
+        } else {
+            x
+        }
+    }
+    fn coord_from_f32(x: f32) -> Result<Self, PointError> {
+        check_coord(x).map(|()| x)
+    }
+    fn vec_to_array(v: glam::Vec3) -> [f32; 3] {
+        v.to_array()
+    }
+    fn array_to_vec(a: [f32; 3]) -> glam::Vec3 {
+        glam::Vec3::from_array(a)
+    }
+    fn check_point(p: [f32; 3]) -> Result<(), PointError> {
+        p.iter().try_for_each(|&x| check_coord(x))
+    }
+    fn check_radius(r: f32) -> Result<(), PointError> {
+        check_coord(r)?;
+        if r < 0.0 {
+            Err(PointError::NegativeRadius)
+        } else {
+            Ok(())
+        }
+    }
+
+    fn ray_data(origin: [f32; 3], dir: [f32; 3]) -> Result<FloatRay, RayError> {
+        FloatRay::new(origin, dir)
+    }
+    fn ray_data_from_f32(origin: [f32; 3], dir: [f32; 3]) -> Result<FloatRay, RayError> {
+        FloatRay::new(origin, dir)
+    }
+    fn ray_origin(ray: &FloatRay) -> [f32; 3] {
+        ray.origin
+    }
+    fn ray_dir(ray: &FloatRay) -> [f32; 3] {
+        ray.dir
+    }
+
+    fn pad_bounds(lo: [f32; 3], hi: [f32; 3]) -> ([f32; 3], [f32; 3]) {
+        let mut m = 0.0f32;
+        for i in 0..3 {
+            m = m.max_of(abs(lo[i])).max_of(abs(hi[i]));
+        }
+        let delta = m * MARGIN;
+        let mut out = (lo, hi);
+        for i in 0..3 {
+            out.0[i] = shift(lo[i], delta, false);
+            out.1[i] = shift(hi[i], delta, true);
+        }
+        out
+    }
+
+    #[inline(always)]
+    fn slab(r: &FloatRay, lo: &[f32; 3], hi: &[f32; 3], t_min: f32, t_max: f32) -> Option<f32> {
+        let mut t_near = t_min;
+        let mut t_far = t_max;
+        for i in 0..3 {
+            let (near, far) = if r.neg[i] {
+                (hi[i], lo[i])
+            } else {
+                (lo[i], hi[i])
+            };
+            // 0 * inf = NaN happens only when a zero-direction ray's shifted origin lies exactly
+            // on a plane; NaN compares false below, so that axis then constrains nothing.
+            let tn = (near - r.o_near[i]) * r.inv[i];
+            let tf = (far - r.o_far[i]) * r.inv[i];
+            if tn > t_near {
+                t_near = tn;
+            }
+            if tf < t_far {
+                t_far = tf;
+            }
+        }
+        if t_near <= Self::widen(t_far) {
+            Some(t_near)
+        } else {
+            None
+        }
+    }
+
+    #[inline(always)]
+    fn widen(t: f32) -> f32 {
+        // Multiplying keeps ±inf as they are (an added margin would make -inf + inf = NaN).
+        if t >= 0.0 {
+            t * (1.0 + 2.0 * MARGIN)
+        } else {
+            t * (1.0 - 2.0 * MARGIN)
+        }
+    }
+
+    #[inline(always)]
+    fn triangle_t(r: &FloatRay, v: &[[f32; 3]; 3], t_min: f32, t_max: f32) -> Option<f32> {
+        // Translate to the ray origin, permute so the dominant axis is z, and shear.
+        let a = r.shear(&v[0]);
+        let b = r.shear(&v[1]);
+        let c = r.shear(&v[2]);
+        // Edge functions; two-sided, so reject only if the signs differ.
+        let [eu, ev, ew] = FloatRay::edges(&a, &b, &c);
+        if (eu < 0.0 || ev < 0.0 || ew < 0.0) && (eu > 0.0 || ev > 0.0 || ew > 0.0) {
+            return None;
+        }
+        let det = eu + ev + ew;
+        if det == 0.0 {
+            return None; // degenerate triangle, or a ray in its plane
+        }
+        // Scaled hit distance. NaN (only from overflow) fails the range test.
+        let t = (eu * a[2] + ev * b[2] + ew * c[2]) / det;
+        if t >= t_min && t <= t_max {
+            Some(t)
+        } else {
+            None
+        }
+    }
+
+    fn triangle_uv(r: &FloatRay, v: &[[f32; 3]; 3]) -> (f32, f32) {
+        let a = r.shear(&v[0]);
+        let b = r.shear(&v[1]);
+        let c = r.shear(&v[2]);
+        let [eu, ev, ew] = FloatRay::edges(&a, &b, &c);
+        let det = eu + ev + ew;
+        if det == 0.0 {
+            return (0.0, 0.0);
+        }
+        (ev / det, ew / det)
+    }
+
+    fn sphere_t(
+        r: &FloatRay,
+        center: &[f32; 3],
+        radius: f32,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<f32> {
+        // Hearn-Baker style discriminant, which stays accurate for small spheres far away
+        // (Haines et al., "Precision Improvements for Ray/Sphere Intersection", RT Gems ch. 7).
+        let d = r.dir;
+        let f = [
+            r.origin[0] - center[0],
+            r.origin[1] - center[1],
+            r.origin[2] - center[2],
+        ];
+        let a = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        let b = -(f[0] * d[0] + f[1] * d[1] + f[2] * d[2]);
+        let s = b / a;
+        let l = [f[0] + s * d[0], f[1] + s * d[1], f[2] + s * d[2]];
+        let disc = radius * radius - (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
+        if !(disc >= 0.0) {
+            return None;
+        }
+        let c = f[0] * f[0] + f[1] * f[1] + f[2] * f[2] - radius * radius;
+        let q = b + libm::copysignf(libm::sqrtf(a * disc), b);
+        if q == 0.0 {
+            return None; // zero radius seen from its own centre
+        }
+        let (t0, t1) = (c / q, q / a);
+        let (near, far) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
+        if near >= t_min && near <= t_max {
+            Some(near)
+        } else if far >= t_min && far <= t_max {
+            Some(far)
+        } else {
+            None
+        }
+    }
+
+    fn sphere_bounds(center: &[f32; 3], radius: f32) -> ([f32; 3], [f32; 3]) {
+        let mut lo = [0.0; 3];
+        let mut hi = [0.0; 3];
+        for i in 0..3 {
+            lo[i] = center[i] - radius;
+            hi[i] = center[i] + radius;
+        }
+        (lo, hi)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn step_moves_one_ulp_each_way() {
+        assert_eq!(step(1.0, true), f32::from_bits(1.0f32.to_bits() + 1));
+        assert_eq!(step(1.0, false), f32::from_bits(1.0f32.to_bits() - 1));
+        assert_eq!(step(-1.0, true), f32::from_bits((-1.0f32).to_bits() - 1));
+        assert!(step(0.0, true) > 0.0 && step(0.0, false) < 0.0);
+    }
+
+    #[test]
+    fn zero_direction_components_give_signed_infinite_inverse() {
+        let r = FloatRay::new([0.0; 3], [0.0, -0.0, 1.0]).unwrap();
+        assert_eq!(r.inv[0], f32::INFINITY);
+        assert_eq!(r.inv[1], f32::NEG_INFINITY);
+        assert!(!r.inv.iter().any(|x| x.is_nan()));
+    }
+}

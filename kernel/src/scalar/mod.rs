@@ -1,0 +1,124 @@
+//! The two number modes: `f32` and the fixed-point [`I16F16`].
+//!
+//! Every algorithm above this module (builders, traversal, queries) is written once, generic over
+//! [`Scalar`]. What must differ between the modes lives here, behind the trait: how a ray is
+//! prepared, the conservative slab test, and the exact-as-possible primitive tests. Each mode's
+//! numerics sit in its own file (`float.rs`, `fixed.rs`).
+
+mod fixed;
+mod float;
+
+pub use fixed::{FixedRay, Vec3x, FIXED_COORD_LIMIT, I16F16};
+pub use float::{FloatRay, F32_COORD_LIMIT};
+
+use crate::error::{PointError, RayError};
+use core::fmt::Debug;
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for f32 {}
+    impl Sealed for super::I16F16 {}
+}
+
+/// The number type the kernel computes in. Implemented for `f32` and [`I16F16`] only.
+///
+/// Determinism contract for both implementations: the same inputs give the same bits on every
+/// platform. Only correctly rounded IEEE operations and `libm` are used in `f32` mode, min/max are
+/// explicit comparisons, and no NaN is ever returned.
+pub trait Scalar:
+    sealed::Sealed + Copy + PartialEq + PartialOrd + Debug + Default + Send + Sync + 'static
+{
+    /// The vector type of the public API: `glam::Vec3` for `f32`, [`crate::Vec3x`] for fixed point.
+    type Vec3: Copy + Debug;
+    /// Per-ray data precomputed once by [`crate::Ray`]'s constructors for the box and primitive tests.
+    type RayData: Copy + Debug;
+
+    /// Zero.
+    const ZERO: Self;
+    /// The far end of an unbounded ray: `+inf` for `f32`, the largest value for fixed point.
+    const FAR: Self;
+    /// Short name of the mode, as used on command lines and in reports: `f32` or `fixed`.
+    const NAME: &'static str;
+
+    /// Converts to `f32` (exact for `f32`; rounds to nearest for fixed point).
+    fn to_f32(self) -> f32;
+    /// Converts from `f32`, saturating at the representable range (NaN gives zero).
+    fn from_f32_saturating(x: f32) -> Self;
+    /// Converts one coordinate from `f32`, failing on NaN, infinity or values outside the mode's
+    /// coordinate range.
+    fn coord_from_f32(x: f32) -> Result<Self, PointError>;
+    /// The public vector type as an array.
+    fn vec_to_array(v: Self::Vec3) -> [Self; 3];
+    /// An array as the public vector type.
+    fn array_to_vec(a: [Self; 3]) -> Self::Vec3;
+    /// Checks that a point is usable as a vertex, sphere centre or ray origin.
+    fn check_point(p: [Self; 3]) -> Result<(), PointError>;
+    /// Checks that a sphere radius is usable (finite / in range, and not negative).
+    fn check_radius(r: Self) -> Result<(), PointError>;
+
+    /// `self` if `self < other`, else `other` (explicit comparison, deterministic for ±0).
+    #[must_use]
+    fn min_of(self, other: Self) -> Self {
+        if self < other {
+            self
+        } else {
+            other
+        }
+    }
+    /// `self` if `self > other`, else `other` (explicit comparison, deterministic for ±0).
+    #[must_use]
+    fn max_of(self, other: Self) -> Self {
+        if self > other {
+            self
+        } else {
+            other
+        }
+    }
+
+    /// Prepares a ray from an origin and a direction given in this mode.
+    fn ray_data(origin: [Self; 3], dir: [Self; 3]) -> Result<Self::RayData, RayError>;
+    /// Prepares a ray from an `f32` origin and direction (for fixed point, the direction keeps
+    /// more precision than a Q16.16 vector could carry).
+    fn ray_data_from_f32(origin: [f32; 3], dir: [f32; 3]) -> Result<Self::RayData, RayError>;
+    /// The ray origin.
+    fn ray_origin(ray: &Self::RayData) -> [Self; 3];
+    /// The (unit-length) ray direction, rounded to this mode.
+    fn ray_dir(ray: &Self::RayData) -> [Self; 3];
+
+    /// Pads a node box outward by this mode's traversal error margin. Identity for fixed point.
+    fn pad_bounds(lo: [Self; 3], hi: [Self; 3]) -> ([Self; 3], [Self; 3]);
+    /// Conservative slab test. Returns the entry distance if the ray's interval `[t_min, t_max]`
+    /// overlaps the box, never culling a box that holds a primitive hit in that interval.
+    fn slab(
+        ray: &Self::RayData,
+        lo: &[Self; 3],
+        hi: &[Self; 3],
+        t_min: Self,
+        t_max: Self,
+    ) -> Option<Self>;
+    /// `t` widened by the slab test's margin: the test accepts boxes entered up to `widen(t)`.
+    #[must_use]
+    fn widen(t: Self) -> Self;
+
+    /// Distance to a two-sided triangle if it is hit within `[t_min, t_max]`.
+    /// Degenerate triangles are never hit.
+    fn triangle_t(
+        ray: &Self::RayData,
+        v: &[[Self; 3]; 3],
+        t_min: Self,
+        t_max: Self,
+    ) -> Option<Self>;
+    /// Barycentrics `(u, v)` of the hit (weights of the second and third vertex). Only meaningful
+    /// for a triangle that [`Scalar::triangle_t`] reports as hit; zero otherwise.
+    fn triangle_uv(ray: &Self::RayData, v: &[[Self; 3]; 3]) -> (Self, Self);
+    /// Distance to a sphere surface if it is hit within `[t_min, t_max]` (nearest root first).
+    fn sphere_t(
+        ray: &Self::RayData,
+        center: &[Self; 3],
+        radius: Self,
+        t_min: Self,
+        t_max: Self,
+    ) -> Option<Self>;
+    /// `center - r` and `center + r` per axis, rounded outward.
+    fn sphere_bounds(center: &[Self; 3], radius: Self) -> ([Self; 3], [Self; 3]);
+}
