@@ -2,9 +2,10 @@
 //! nodes replaces recursion. Split decisions use `f32` keys (centroids, areas) in both modes;
 //! `f32` arithmetic is deterministic, so fixed-point trees are identical on every platform too.
 
-use super::select::{partition, select_nth};
+use super::select::select_nth;
 use super::{
-    nodes_needed, BuildOptions, BuilderKind, Node, MAX_DEPTH, MAX_LEAF_SIZE, MEDIAN_FALLBACK_DEPTH,
+    nodes_needed, BuildOptions, BuilderKind, Node, FIRST_PAIR, MAX_DEPTH, MAX_LEAF_SIZE,
+    MEDIAN_FALLBACK_DEPTH,
 };
 use crate::error::{Arena, BuildError};
 use crate::geom::{Aabb, Primitive};
@@ -67,36 +68,46 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
         kind: options.builder,
         _scalar: core::marker::PhantomData,
     };
-    nodes[0] = Node::leaf(builder.bounds(ids), 0, n as u32);
+    let root = builder.summarize(ids);
+    nodes[0] = Node::leaf(root.bounds, 0, n as u32);
     let mut used = 1usize;
+    if n > 1 {
+        nodes[1] = Node::EMPTY;
+        used = FIRST_PAIR;
+    }
     let mut deepest = 0u32;
-    // Pending nodes: at most one sibling per level plus the current one.
-    let mut stack = [(0u32, 0u32); MAX_DEPTH + 2];
+    // Pending nodes with their centroid bounds: at most one sibling per level plus the current.
+    let mut stack = [Pending {
+        index: 0,
+        depth: 0,
+        centroids: root.centroids,
+    }; MAX_DEPTH + 2];
     let mut sp = 1usize;
+    let mut bins = [[(empty_box::<S>(), 0u32); BINS]; 3];
     while sp > 0 {
         sp -= 1;
-        let (index, depth) = stack[sp];
+        let Pending {
+            index,
+            depth,
+            centroids,
+        } = stack[sp];
         let node = nodes[index as usize];
         let (first, count) = (node.first as usize, node.count as usize);
         deepest = deepest.max(depth);
         let Some(range) = ids.get_mut(first..first + count) else {
             continue;
         };
-        let Some(split) = builder.split(range, depth as usize) else {
+        let Some([left, right]) = builder.split(range, depth as usize, &centroids, &mut bins)
+        else {
             continue;
         };
-        let (left, right) = range.split_at(split.mid);
         let l = used;
         used += 2;
-        nodes[l] = Node::leaf(
-            split.left.unwrap_or_else(|| builder.bounds(left)),
-            first as u32,
-            split.mid as u32,
-        );
+        nodes[l] = Node::leaf(left.bounds, first as u32, left.count as u32);
         nodes[l + 1] = Node::leaf(
-            split.right.unwrap_or_else(|| builder.bounds(right)),
-            (first + split.mid) as u32,
-            (count - split.mid) as u32,
+            right.bounds,
+            (first + left.count) as u32,
+            right.count as u32,
         );
         nodes[index as usize] = Node {
             first: l as u32,
@@ -104,9 +115,13 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
             ..node
         };
         // Right pushed first so the left subtree is built (and laid out) first.
-        for child in [l + 1, l] {
+        for (child, side) in [(l + 1, right), (l, left)] {
             if let Some(slot) = stack.get_mut(sp) {
-                *slot = (child as u32, depth + 1);
+                *slot = Pending {
+                    index: child as u32,
+                    depth: depth + 1,
+                    centroids: side.centroids,
+                };
                 sp += 1;
             }
         }
@@ -119,20 +134,44 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
     Ok((used, deepest))
 }
 
-/// A chosen split: ids are already partitioned so `ids[..mid]` go left.
-/// Child bounds are filled in when the split search already knows them.
-struct Split<S: Scalar> {
-    mid: usize,
-    left: Option<Aabb<S>>,
-    right: Option<Aabb<S>>,
+/// SAH bins per axis: box and primitive count.
+type Bins<S> = [[(Aabb<S>, u32); BINS]; 3];
+
+/// A node waiting to be split.
+#[derive(Clone, Copy)]
+struct Pending {
+    index: u32,
+    depth: u32,
+    centroids: Centroids,
 }
 
-impl<S: Scalar> Split<S> {
-    fn at(mid: usize) -> Self {
+/// Per-axis (min, max) of the centroid keys of a set of primitives.
+type Centroids = ([f32; 3], [f32; 3]);
+
+/// What a split search knows about one side: its size, box and centroid bounds.
+#[derive(Clone, Copy)]
+struct Side<S: Scalar> {
+    count: usize,
+    bounds: Aabb<S>,
+    centroids: Centroids,
+}
+
+impl<S: Scalar> Side<S> {
+    fn empty() -> Self {
         Self {
-            mid,
-            left: None,
-            right: None,
+            count: 0,
+            bounds: empty_box(),
+            centroids: ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+        }
+    }
+
+    fn add(&mut self, b: &Aabb<S>) {
+        self.count += 1;
+        self.bounds = self.bounds.union(b);
+        for axis in 0..3 {
+            let c = key(b, axis);
+            self.centroids.0[axis] = self.centroids.0[axis].min_of(c);
+            self.centroids.1[axis] = self.centroids.1[axis].max_of(c);
         }
     }
 }
@@ -174,33 +213,46 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         }
     }
 
-    fn bounds(&self, ids: &[u32]) -> Aabb<S> {
-        ids.iter()
-            .fold(empty_box(), |acc, &id| acc.union(&self.prim(id)))
+    /// Count, box and centroid bounds of `ids`.
+    fn summarize(&self, ids: &[u32]) -> Side<S> {
+        let mut side = Side::empty();
+        for &id in ids {
+            side.add(&self.prim(id));
+        }
+        side
     }
 
-    /// Centroid-key bounds of `ids`: (min, max) per axis.
-    fn centroid_bounds(&self, ids: &[u32]) -> ([f32; 3], [f32; 3]) {
-        let mut lo = [f32::INFINITY; 3];
-        let mut hi = [f32::NEG_INFINITY; 3];
-        for &id in ids {
-            let b = self.prim(id);
-            for axis in 0..3 {
-                let c = key(&b, axis);
-                lo[axis] = lo[axis].min_of(c);
-                hi[axis] = hi[axis].max_of(c);
+    /// Partitions `ids` by `left`, summarizing both sides on the way.
+    fn partition_by(&self, ids: &mut [u32], left: impl Fn(&Aabb<S>) -> bool) -> [Side<S>; 2] {
+        let mut sides = [Side::empty(), Side::empty()];
+        let (mut i, mut j) = (0, ids.len());
+        while i < j {
+            let b = self.prim(ids[i]);
+            if left(&b) {
+                sides[0].add(&b);
+                i += 1;
+            } else {
+                sides[1].add(&b);
+                j -= 1;
+                ids.swap(i, j);
             }
         }
-        (lo, hi)
+        sides
     }
 
-    /// Decides whether and where to split `ids`; `None` makes a leaf.
-    fn split(&self, ids: &mut [u32], depth: usize) -> Option<Split<S>> {
+    /// Decides whether and where to split `ids` (partitioning them); `None` makes a leaf.
+    fn split(
+        &self,
+        ids: &mut [u32],
+        depth: usize,
+        centroids: &Centroids,
+        bins: &mut Bins<S>,
+    ) -> Option<[Side<S>; 2]> {
         let count = ids.len();
         if count <= 1 {
             return None;
         }
-        let (clo, chi) = self.centroid_bounds(ids);
+        let (clo, chi) = centroids;
         let extent: [f32; 3] = core::array::from_fn(|i| chi[i] - clo[i]);
         let widest = if extent[0] >= extent[1] && extent[0] >= extent[2] {
             0
@@ -209,40 +261,54 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         } else {
             2
         };
+        let must_split = count > self.max_leaf;
         if depth >= MEDIAN_FALLBACK_DEPTH {
-            return (count > self.max_leaf).then(|| self.median(ids, widest));
+            return must_split.then(|| self.median(ids, widest));
         }
         match self.kind {
-            BuilderKind::Median => (count > self.max_leaf).then(|| self.median(ids, widest)),
-            BuilderKind::Midpoint => (count > self.max_leaf).then(|| {
+            BuilderKind::Median => must_split.then(|| self.median(ids, widest)),
+            BuilderKind::Midpoint => must_split.then(|| {
                 let mid = clo[widest] * 0.5 + chi[widest] * 0.5;
-                let k = partition(ids, |id| key(&self.prim(id), widest) < mid);
-                if k == 0 || k == count {
+                let sides = self.partition_by(ids, |b| key(b, widest) < mid);
+                if sides[0].count == 0 || sides[1].count == 0 {
                     self.median(ids, widest)
                 } else {
-                    Split::at(k)
+                    sides
                 }
             }),
-            BuilderKind::Sah => match self.sah(ids, &clo, &extent) {
-                Some(s) => Some(s),
-                None => (count > self.max_leaf).then(|| self.median(ids, widest)),
+            BuilderKind::Sah => match self.sah(ids, clo, &extent, bins) {
+                Some(sides) => Some(sides),
+                None => must_split.then(|| self.median(ids, widest)),
             },
         }
     }
 
-    fn median(&self, ids: &mut [u32], axis: usize) -> Split<S> {
+    fn median(&self, ids: &mut [u32], axis: usize) -> [Side<S>; 2] {
         let mid = ids.len() / 2;
         select_nth(ids, mid, |id| key(&self.prim(id), axis));
-        Split::at(mid)
+        let (left, right) = ids.split_at(mid);
+        [self.summarize(left), self.summarize(right)]
     }
 
     /// Binned SAH over all three axes. `None` when a leaf is cheaper (and allowed) or no axis
     /// separates the centroids.
-    fn sah(&self, ids: &mut [u32], clo: &[f32; 3], extent: &[f32; 3]) -> Option<Split<S>> {
+    fn sah(
+        &self,
+        ids: &mut [u32],
+        clo: &[f32; 3],
+        extent: &[f32; 3],
+        bins: &mut Bins<S>,
+    ) -> Option<[Side<S>; 2]> {
         let count = ids.len();
-        let mut bins = [[(empty_box::<S>(), 0u32); BINS]; 3];
+        // Small nodes use fewer bins: the same choices for less set-up work.
+        let nb = count.clamp(8, BINS);
+        for axis_bins in bins.iter_mut() {
+            for bin in axis_bins.iter_mut().take(nb) {
+                *bin = (empty_box(), 0);
+            }
+        }
         let scale: [f32; 3] = core::array::from_fn(|a| {
-            let s = BINS as f32 / extent[a];
+            let s = nb as f32 / extent[a];
             if extent[a] > 0.0 && s.is_finite() {
                 s
             } else {
@@ -251,10 +317,10 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         });
         let bin_of = |c: f32, a: usize| -> usize {
             let b = ((c - clo[a]) * scale[a]) as usize; // saturating cast, NaN -> 0
-            if b < BINS {
+            if b < nb {
                 b
             } else {
-                BINS - 1
+                nb - 1
             }
         };
         for &id in ids.iter() {
@@ -266,51 +332,42 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
             }
         }
         // Sweep each axis: cost(split after bin i) = A_left·N_left + A_right·N_right.
-        let mut best: Option<(f32, usize, usize, Aabb<S>, Aabb<S>)> = None;
+        let mut best: Option<(f32, usize, usize, Aabb<S>)> = None;
         for a in 0..3 {
             if scale[a] == 0.0 {
                 continue;
             }
-            let mut right_area = [0.0f32; BINS];
-            let mut right_box = [empty_box::<S>(); BINS];
-            let mut acc = (empty_box::<S>(), 0u32);
-            for i in (1..BINS).rev() {
-                acc.0 = acc.0.union(&bins[a][i].0);
-                acc.1 += bins[a][i].1;
-                right_area[i] = if acc.1 > 0 {
-                    half_area(&acc.0) * acc.1 as f32
+            let mut right_cost = [0.0f32; BINS];
+            let mut right = (empty_box::<S>(), 0u32);
+            for i in (1..nb).rev() {
+                right.0 = right.0.union(&bins[a][i].0);
+                right.1 += bins[a][i].1;
+                right_cost[i] = if right.1 > 0 {
+                    half_area(&right.0) * right.1 as f32
                 } else {
                     0.0
                 };
-                right_box[i] = acc.0;
             }
             let mut left = (empty_box::<S>(), 0u32);
-            for i in 0..BINS - 1 {
+            for i in 0..nb - 1 {
                 left.0 = left.0.union(&bins[a][i].0);
                 left.1 += bins[a][i].1;
                 if left.1 == 0 || left.1 as usize == count {
                     continue;
                 }
-                let cost = half_area(&left.0) * left.1 as f32 + right_area[i + 1];
+                let cost = half_area(&left.0) * left.1 as f32 + right_cost[i + 1];
                 if best.map_or(true, |b| cost < b.0) {
-                    best = Some((cost, a, i, left.0, right_box[i + 1]));
+                    best = Some((cost, a, i, left.0.union(&right.0)));
                 }
             }
         }
-        let (cost, axis, last_left_bin, lbox, rbox) = best?;
-        let parent_area = half_area(&lbox.union(&rbox));
-        let split_cost = TRAVERSAL_COST * parent_area + cost;
-        let leaf_cost = parent_area * count as f32;
-        if count <= self.max_leaf && leaf_cost <= split_cost {
+        let (cost, axis, last_left_bin, parent) = best?;
+        let parent_area = half_area(&parent);
+        if count <= self.max_leaf
+            && parent_area * count as f32 <= TRAVERSAL_COST * parent_area + cost
+        {
             return None;
         }
-        let mid = partition(ids, |id| {
-            bin_of(key(&self.prim(id), axis), axis) <= last_left_bin
-        });
-        Some(Split {
-            mid,
-            left: Some(lbox),
-            right: Some(rbox),
-        })
+        Some(self.partition_by(ids, |b| bin_of(key(b, axis), axis) <= last_left_bin))
     }
 }

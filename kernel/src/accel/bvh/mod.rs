@@ -31,16 +31,21 @@ pub const MEDIAN_FALLBACK_DEPTH: usize = MAX_DEPTH - 32;
 /// Largest accepted `max_leaf_size`.
 pub const MAX_LEAF_SIZE: u32 = 64;
 
-/// Exact node slots [`Bvh::build`] needs for `prim_count` primitives: `2n - 1` (0 for none),
-/// the size of a binary tree whose leaves hold one primitive each.
+/// Exact node slots [`Bvh::build`] needs for `prim_count` primitives in the worst case:
+/// `2n` for `n >= 2` (a binary tree with one primitive per leaf has `2n - 1` nodes, and slot 1
+/// stays unused so that sibling pairs start at even slots), 1 for one primitive, 0 for none.
+///
+/// Sibling pairs are 64 bytes; with the arena aligned to 64 bytes each pair is one cache line.
 #[must_use]
 pub const fn nodes_needed(prim_count: usize) -> usize {
-    if prim_count == 0 {
-        0
-    } else {
-        prim_count.saturating_mul(2) - 1
+    match prim_count {
+        0 | 1 => prim_count,
+        n => n.saturating_mul(2),
     }
 }
+
+/// Index of the first child pair: slot 1 is padding so pairs sit at even slots.
+pub(crate) const FIRST_PAIR: usize = 2;
 
 /// How to choose splits.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

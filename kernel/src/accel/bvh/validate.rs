@@ -116,7 +116,7 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                 continue;
             }
             let l = node.first as usize;
-            if l <= index || l + 1 >= self.nodes.len() {
+            if l <= index || l % 2 != 0 || l + 1 >= self.nodes.len() {
                 return Err(InvalidTree::BadChild { node: index });
             }
             for child in [l + 1, l] {
