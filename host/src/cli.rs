@@ -1,0 +1,197 @@
+//! The command line: argument types (clap derive) and the commands behind them.
+//!
+//! Each command returns the JSON object `main` prints as the last line of stdout.
+
+use crate::compare::{compare_hits, Comparison, DEFAULT_REL};
+use crate::error::Error;
+use crate::obj::load_obj;
+use crate::rayfile::{read_hits, read_rays, write_hits};
+use crate::trace::{trace, AccelKind, Builder, Mode, TraceConfig};
+use clap::builder::RangedU64ValueParser;
+use clap::{Args, Parser, Subcommand};
+use raykernel::bvh::{BuildOptions, BuilderKind, MAX_LEAF_SIZE};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// Command-line host for raykernel.
+#[derive(Debug, Parser)]
+#[command(name = "host", version, about)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Trace a ray file against an OBJ scene and write the closest hits.
+    Trace(TraceArgs),
+    /// Compare two hit files ray by ray (same rule as shared/bench/compare_hits.py).
+    CompareHits(CompareArgs),
+}
+
+/// `host trace SCENE.obj RAYS --out HITS [options]`.
+#[derive(Clone, Debug, Args)]
+pub struct TraceArgs {
+    /// The scene (Wavefront OBJ).
+    pub scene: PathBuf,
+    /// The rays: 32-byte records `ox oy oz dx dy dz tmin tmax`, little-endian f32.
+    pub rays: PathBuf,
+    /// Where to write the hits: 8-byte records `t: f32, prim: u32` per traced ray.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Accelerator.
+    #[arg(long, value_enum, default_value_t = AccelKind::Bvh)]
+    pub accel: AccelKind,
+    /// BVH builder.
+    #[arg(long, value_enum, default_value_t = Builder::Sah)]
+    pub builder: Builder,
+    /// Number mode.
+    #[arg(long, value_enum, default_value_t = Mode::F32)]
+    pub mode: Mode,
+    /// Largest BVH leaf (1..=64).
+    #[arg(long, default_value_t = 4,
+          value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_LEAF_SIZE)))]
+    pub leaf: u32,
+    /// Trace only rays 0, K, 2K, ... (hit files of equal stride are comparable).
+    #[arg(long, value_name = "K", default_value_t = 1,
+          value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
+    pub stride: usize,
+}
+
+/// `host compare-hits REF OTHER [--rel R]`.
+#[derive(Clone, Debug, Args)]
+pub struct CompareArgs {
+    /// The reference hit file.
+    pub reference: PathBuf,
+    /// The hit file to compare with it.
+    pub other: PathBuf,
+    /// Relative tolerance on t.
+    #[arg(long, default_value_t = DEFAULT_REL)]
+    pub rel: f64,
+}
+
+/// The JSON report of `host trace`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TraceReport {
+    /// Scene path.
+    pub scene: String,
+    /// Ray file path.
+    pub rays_file: String,
+    /// Hit file path.
+    pub out: String,
+    /// `bvh` or `linear`.
+    pub accel: &'static str,
+    /// `sah`, `median` or `midpoint`; `null` for linear.
+    pub builder: Option<&'static str>,
+    /// `f32` or `fixed`.
+    pub mode: &'static str,
+    /// Largest leaf.
+    pub leaf: u32,
+    /// Ray stride.
+    pub stride: usize,
+    /// Triangles in the scene.
+    pub triangles: usize,
+    /// Wall time of the build (0 for linear).
+    pub build_ms: f64,
+    /// Wall time of tracing and storing every traced ray (no file I/O).
+    pub trace_ms: f64,
+    /// Rays traced.
+    pub rays: usize,
+    /// Rays in the file.
+    pub rays_in_file: usize,
+    /// Million rays per second of trace time.
+    pub mrays_per_s: f64,
+    /// Rays that hit.
+    pub hits: usize,
+    /// Rays the kernel rejected, written as misses.
+    pub bad_rays: usize,
+    /// BVH nodes (0 for linear).
+    pub nodes: usize,
+    /// Bytes of BVH nodes and primitive ids per triangle (0 for linear).
+    pub bytes_per_tri: f64,
+    /// BVH depth (0 for linear).
+    pub depth: u32,
+}
+
+/// Runs a parsed command line; returns the one-line JSON object to print.
+///
+/// # Errors
+/// Whatever the command fails with.
+pub fn run(cli: &Cli) -> Result<String, Error> {
+    let json = match &cli.command {
+        Command::Trace(args) => serde_json::to_string(&run_trace(args)?),
+        Command::CompareHits(args) => serde_json::to_string(&run_compare(args)?),
+    };
+    // Structs of numbers and strings always serialize; the fallback only avoids a panic path.
+    Ok(json.unwrap_or_else(|e| format!("{{\"error\":\"cannot encode report: {e}\"}}")))
+}
+
+/// `host trace`: load the scene and rays, trace, write the hits.
+///
+/// # Errors
+/// Bad or unreadable inputs, an unwritable output, or a build the kernel refuses.
+pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
+    let mesh = load_obj(&args.scene)?;
+    let rays = read_rays(&args.rays)?;
+    let config = TraceConfig {
+        accel: args.accel,
+        build: BuildOptions {
+            builder: args.builder.into(),
+            max_leaf_size: args.leaf,
+        },
+        mode: args.mode,
+        stride: args.stride,
+    };
+    let output = trace(&mesh, &args.scene, &rays, &config)?;
+    write_hits(&args.out, &output.hits)?;
+    let s = output.stats;
+    let secs = s.trace_ms / 1e3;
+    Ok(TraceReport {
+        scene: args.scene.display().to_string(),
+        rays_file: args.rays.display().to_string(),
+        out: args.out.display().to_string(),
+        accel: args.accel.name(),
+        builder: (args.accel == AccelKind::Bvh).then(|| BuilderKind::from(args.builder).name()),
+        mode: args.mode.name(),
+        leaf: args.leaf,
+        stride: args.stride,
+        triangles: s.triangles,
+        build_ms: s.build_ms,
+        trace_ms: s.trace_ms,
+        rays: s.rays,
+        rays_in_file: rays.len(),
+        mrays_per_s: if secs > 0.0 {
+            s.rays as f64 / secs / 1e6
+        } else {
+            0.0
+        },
+        hits: s.hits,
+        bad_rays: s.bad_rays,
+        nodes: s.nodes,
+        bytes_per_tri: if s.triangles > 0 {
+            s.accel_bytes as f64 / s.triangles as f64
+        } else {
+            0.0
+        },
+        depth: s.depth,
+    })
+}
+
+/// `host compare-hits`: agreement of OTHER with REF.
+///
+/// # Errors
+/// Unreadable or malformed hit files, or files of different lengths.
+pub fn run_compare(args: &CompareArgs) -> Result<Comparison, Error> {
+    let reference = read_hits(&args.reference)?;
+    let other = read_hits(&args.other)?;
+    if reference.len() != other.len() {
+        let entry = |p: &Path, n| (p.to_path_buf(), n);
+        return Err(Error::HitCountMismatch {
+            reference: entry(&args.reference, reference.len()),
+            other: entry(&args.other, other.len()),
+        });
+    }
+    Ok(compare_hits(&reference, &other, args.rel))
+}

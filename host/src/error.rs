@@ -1,0 +1,81 @@
+//! The host's error type: one variant per source, each printing one self-contained line.
+
+use crate::obj::ObjError;
+use crate::rayfile::FileError;
+use raykernel::BuildError;
+use std::fmt;
+use std::path::PathBuf;
+
+/// Anything a host command can fail with. Bad command lines are clap's business (exit code 2).
+#[derive(Debug)]
+pub enum Error {
+    /// A bad or unreadable OBJ file.
+    Obj(ObjError),
+    /// A bad, unreadable or unwritable ray or hit file.
+    File(FileError),
+    /// The kernel refused to build the accelerator.
+    Build {
+        /// The scene.
+        scene: PathBuf,
+        /// Why.
+        source: BuildError,
+    },
+    /// Two hit files to compare hold different numbers of records.
+    HitCountMismatch {
+        /// The reference file and its record count.
+        reference: (PathBuf, usize),
+        /// The other file and its record count.
+        other: (PathBuf, usize),
+    },
+}
+
+impl Error {
+    /// The process exit code for this error: 1 (2 is clap's, for bad arguments).
+    #[must_use]
+    pub fn exit_code(&self) -> u8 {
+        1
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Obj(e) => e.fmt(f),
+            Self::File(e) => e.fmt(f),
+            Self::Build { scene, source } => {
+                write!(f, "{}: cannot build the BVH: {source}", scene.display())
+            }
+            Self::HitCountMismatch { reference, other } => write!(
+                f,
+                "hit files differ in length: {} has {} records, {} has {}",
+                reference.0.display(),
+                reference.1,
+                other.0.display(),
+                other.1
+            ),
+        }
+    }
+}
+
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Self::Obj(e) => Some(e),
+            Self::File(e) => Some(e),
+            Self::Build { source, .. } => Some(source),
+            Self::HitCountMismatch { .. } => None,
+        }
+    }
+}
+
+impl From<ObjError> for Error {
+    fn from(e: ObjError) -> Self {
+        Self::Obj(e)
+    }
+}
+
+impl From<FileError> for Error {
+    fn from(e: FileError) -> Self {
+        Self::File(e)
+    }
+}

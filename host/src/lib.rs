@@ -1,0 +1,21 @@
+//! Host side of raykernel: OBJ scenes, ray and hit files, and the `host` command line.
+//!
+//! Everything the binary does lives here so it can be tested without spawning it:
+//! - [`obj`]: OBJ reader with `file:line` errors,
+//! - [`rayfile`]: ray and hit file records,
+//! - [`trace`]: build an accelerator and trace rays, generic over the kernel's scalar modes,
+//! - [`compare`]: agreement between two hit files,
+//! - [`cli`]: the command line (clap) and the commands behind it,
+//! - [`error`]: the error type `main` turns into a message and an exit code.
+#![forbid(unsafe_code)]
+
+pub mod cli;
+pub mod compare;
+pub mod error;
+pub mod obj;
+pub mod rayfile;
+pub mod trace;
+
+pub use error::Error;
+pub use obj::{load_obj, parse_obj, Mesh, ObjError, ObjErrorKind};
+pub use rayfile::{FileError, HitRecord, RayRecord};
