@@ -43,3 +43,8 @@ pub use error::{Arena, BuildError, PointError, RayError};
 pub use geom::{Aabb, Hit, Primitive, Ray, Sphere, Triangle};
 pub use glam;
 pub use scalar::{Scalar, Vec3x, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16};
+
+/// The README's Rust examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../../README.md")]
+struct ReadmeDoctests;

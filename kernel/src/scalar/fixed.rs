@@ -179,12 +179,11 @@ pub struct FixedRay {
     dir: [i64; 3],
     /// `2^62 / dir` truncated (`i64::MAX` for a zero component).
     recip: [i64; 3],
-    /// Origin moved one raw unit so near distances are never overestimated.
-    o_near: [i64; 3],
-    /// Origin moved one raw unit so far distances are never underestimated.
-    o_far: [i64; 3],
-    /// Per axis: the direction is negative, so the near plane is the box's `hi`.
-    neg: [bool; 3],
+    /// Origin as seen from the boxes' `lo` planes, moved one raw unit so the distance to the
+    /// nearer of the two planes is never overestimated and to the farther never underestimated.
+    o_lo: [i64; 3],
+    /// Origin as seen from the boxes' `hi` planes.
+    o_hi: [i64; 3],
 }
 
 fn check_raw(x: i32) -> Result<(), PointError> {
@@ -206,9 +205,8 @@ impl FixedRay {
             origin: [0; 3],
             dir: [0; 3],
             recip: [0; 3],
-            o_near: [0; 3],
-            o_far: [0; 3],
-            neg: [false; 3],
+            o_lo: [0; 3],
+            o_hi: [0; 3],
         };
         for i in 0..3 {
             let o = origin[i].0 as i64;
@@ -217,9 +215,8 @@ impl FixedRay {
             r.origin[i] = o;
             r.dir[i] = d;
             r.recip[i] = if d == 0 { i64::MAX } else { (1i64 << 62) / d };
-            r.neg[i] = d < 0;
-            r.o_near[i] = o + s;
-            r.o_far[i] = o - s;
+            r.o_lo[i] = o + s;
+            r.o_hi[i] = o - s;
         }
         Ok(r)
     }
@@ -340,15 +337,10 @@ impl Scalar for I16F16 {
         let mut t_near = t_min.0 as i64;
         let mut t_far = t_max.0 as i64 + SLAB_PAD;
         for i in 0..3 {
-            let (near, far) = if r.neg[i] {
-                (hi[i].0, lo[i].0)
-            } else {
-                (lo[i].0, hi[i].0)
-            };
-            let tn = (((near as i64 - r.o_near[i]) as i128 * r.recip[i] as i128) >> 32) as i64;
-            let tf = (((far as i64 - r.o_far[i]) as i128 * r.recip[i] as i128) >> 32) as i64;
-            t_near = t_near.max(tn - SLAB_PAD);
-            t_far = t_far.min(tf + SLAB_PAD);
+            let a = (((lo[i].0 as i64 - r.o_lo[i]) as i128 * r.recip[i] as i128) >> 32) as i64;
+            let b = (((hi[i].0 as i64 - r.o_hi[i]) as i128 * r.recip[i] as i128) >> 32) as i64;
+            t_near = t_near.max(a.min(b) - SLAB_PAD);
+            t_far = t_far.min(a.max(b) + SLAB_PAD);
         }
         // t_near <= t_far <= t_max + pad, and t_near >= t_min >= 0: fits after the clamp.
         if t_near <= t_far {

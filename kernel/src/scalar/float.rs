@@ -25,12 +25,11 @@ pub struct FloatRay {
     dir: [f32; 3],
     /// `1 / dir`, `±inf` for `±0` components (sign preserved, never NaN).
     inv: [f32; 3],
-    /// Origin moved so the near plane distance is never overestimated.
-    o_near: [f32; 3],
-    /// Origin moved so the far plane distance is never underestimated.
-    o_far: [f32; 3],
-    /// Per axis: the direction's sign bit is set, so the near plane is the box's `hi`.
-    neg: [bool; 3],
+    /// Origin as seen from the boxes' `lo` planes, moved so that the distance to whichever of
+    /// the two planes is nearer is never overestimated, and to the farther never underestimated.
+    o_lo: [f32; 3],
+    /// Origin as seen from the boxes' `hi` planes (see `o_lo`).
+    o_hi: [f32; 3],
     /// Watertight test: axis permutation (kx, ky, kz), each < 3; kept as indices into `[f32; 4]`.
     k: [usize; 3],
     /// Watertight test: shear constants Sx, Sy, Sz.
@@ -103,15 +102,17 @@ impl FloatRay {
         let o_max = abs(origin[0]).max_of(abs(origin[1])).max_of(abs(origin[2]));
         let delta = o_max * MARGIN;
         let mut inv = [0.0; 3];
-        let mut neg = [false; 3];
-        let mut o_near = [0.0; 3];
-        let mut o_far = [0.0; 3];
+        let mut o_lo = [0.0; 3];
+        let mut o_hi = [0.0; 3];
         for i in 0..3 {
             inv[i] = 1.0 / dir[i];
-            neg[i] = dir[i].is_sign_negative();
-            // Moving the origin towards +dir makes near distances smaller; away, far ones larger.
-            o_near[i] = shift(origin[i], delta, !neg[i]);
-            o_far[i] = shift(origin[i], delta, neg[i]);
+            // For a positive (or +0) direction `lo` is the near plane: moving the origin up
+            // shrinks its distance; `hi` is the far one: moving down grows it. Mirrored for
+            // negative. A zero component gets both shifts, so an origin inside the slab sees
+            // `-inf` and `+inf`.
+            let up = !dir[i].is_sign_negative();
+            o_lo[i] = shift(origin[i], delta, up);
+            o_hi[i] = shift(origin[i], delta, !up);
         }
 
         // Watertight test: kz is the dominant axis; swapping kx/ky keeps the winding.
@@ -133,9 +134,8 @@ impl FloatRay {
             origin,
             dir,
             inv,
-            o_near,
-            o_far,
-            neg,
+            o_lo,
+            o_hi,
             k: [kx, ky, kz],
             shear,
         })
@@ -249,20 +249,18 @@ impl Scalar for f32 {
         let mut t_near = t_min;
         let mut t_far = t_max;
         for i in 0..3 {
-            let (near, far) = if r.neg[i] {
-                (hi[i], lo[i])
-            } else {
-                (lo[i], hi[i])
-            };
+            let a = (lo[i] - r.o_lo[i]) * r.inv[i];
+            let b = (hi[i] - r.o_hi[i]) * r.inv[i];
             // 0 * inf = NaN happens only when a zero-direction ray's shifted origin lies exactly
-            // on a plane; NaN compares false below, so that axis then constrains nothing.
-            let tn = (near - r.o_near[i]) * r.inv[i];
-            let tf = (far - r.o_far[i]) * r.inv[i];
-            if tn > t_near {
-                t_near = tn;
+            // on a plane. Every comparison below is false for NaN and keeps the other operand,
+            // so such an axis constrains nothing (the conservative answer).
+            let near = if b < a { b } else { a };
+            let far = if a > b { a } else { b };
+            if near > t_near {
+                t_near = near;
             }
-            if tf < t_far {
-                t_far = tf;
+            if far < t_far {
+                t_far = far;
             }
         }
         if t_near <= Self::widen(t_far) {
@@ -274,12 +272,9 @@ impl Scalar for f32 {
 
     #[inline(always)]
     fn widen(t: f32) -> f32 {
-        // Multiplying keeps ±inf as they are (an added margin would make -inf + inf = NaN).
-        if t >= 0.0 {
-            t * (1.0 + 2.0 * MARGIN)
-        } else {
-            t * (1.0 - 2.0 * MARGIN)
-        }
+        // Only non-negative ends matter (t_near >= t_min >= 0); negative ones stay negative.
+        // Multiplying keeps ±inf as they are.
+        t * (1.0 + 2.0 * MARGIN)
     }
 
     #[inline(always)]

@@ -96,7 +96,8 @@ pub trait Scalar:
         t_min: Self,
         t_max: Self,
     ) -> Option<Self>;
-    /// `t` widened by the slab test's margin: the test accepts boxes entered up to `widen(t)`.
+    /// `t >= 0` widened by the slab test's margin: the test accepts boxes entered up to
+    /// `widen(t)`.
     #[must_use]
     fn widen(t: Self) -> Self;
 

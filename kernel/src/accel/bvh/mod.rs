@@ -100,6 +100,9 @@ pub struct Bvh<'a, S: Scalar, P: Primitive<S>> {
     prim_ids: &'a [u32],
     prims: &'a [P],
     depth: u32,
+    /// `prims[i]` is the primitive with id `prim_ids[i]` (see [`Bvh::build_in_leaf_order`]);
+    /// otherwise `prims` is in id order.
+    leaf_order: bool,
     _scalar: PhantomData<S>,
 }
 
@@ -126,8 +129,83 @@ impl<'a, S: Scalar, P: Primitive<S>> Bvh<'a, S, P> {
             prim_ids: prim_ids.get(..prims.len()).unwrap_or_default(),
             prims,
             depth,
+            leaf_order: false,
             _scalar: PhantomData,
         })
+    }
+
+    /// As [`Bvh::build`], then permutes `prims` in place into leaf order, so each leaf's
+    /// primitives are contiguous in memory: faster traversal, one indirection fewer.
+    /// Afterwards `prims[i]` is the primitive whose original index is `prim_ids[i]`; hits still
+    /// report original indices, and ties still go to the lowest original index.
+    ///
+    /// # Errors
+    /// As [`Bvh::build`]; also [`BuildError::TooManyPrims`] above `2^31 - 1` primitives (the
+    /// permutation marks visited ids in their top bit).
+    pub fn build_in_leaf_order(
+        prims: &'a mut [P],
+        nodes: &'a mut [Node<S>],
+        prim_ids: &'a mut [u32],
+        options: BuildOptions,
+    ) -> Result<Self, BuildError>
+    where
+        P: Copy,
+    {
+        const MARK: u32 = 1 << 31;
+        if prims.len() >= MARK as usize {
+            return Err(BuildError::TooManyPrims { count: prims.len() });
+        }
+        let (node_count, depth) = build::build(prims, nodes, prim_ids, options)?;
+        let ids = &mut prim_ids[..prims.len()];
+        // Apply the permutation cycle by cycle: slot j receives the primitive ids[j].
+        for start in 0..ids.len() {
+            if ids[start] & MARK != 0 {
+                continue;
+            }
+            let first = prims[start];
+            let mut j = start;
+            loop {
+                let k = ids[j] as usize;
+                ids[j] |= MARK;
+                if k == start {
+                    prims[j] = first;
+                    break;
+                }
+                prims[j] = prims[k];
+                j = k;
+            }
+        }
+        for id in ids.iter_mut() {
+            *id &= !MARK;
+        }
+        let nodes: &'a [Node<S>] = nodes;
+        let prim_ids: &'a [u32] = prim_ids;
+        let prims: &'a [P] = prims;
+        Ok(Self {
+            nodes: nodes.get(..node_count).unwrap_or_default(),
+            prim_ids: prim_ids.get(..prims.len()).unwrap_or_default(),
+            prims,
+            depth,
+            leaf_order: true,
+            _scalar: PhantomData,
+        })
+    }
+
+    /// The primitive with original index `id`, if `prims` are still in id order (`None` after
+    /// [`Bvh::build_in_leaf_order`]: look it up through [`Bvh::prim_ids`] instead).
+    #[must_use]
+    pub fn prim(&self, id: u32) -> Option<&'a P> {
+        if self.leaf_order {
+            None
+        } else {
+            self.prims.get(id as usize)
+        }
+    }
+
+    /// True if the primitives were permuted into leaf order.
+    #[must_use]
+    pub fn is_leaf_order(&self) -> bool {
+        self.leaf_order
     }
 
     /// The nodes in use (root first).
@@ -140,7 +218,7 @@ impl<'a, S: Scalar, P: Primitive<S>> Bvh<'a, S, P> {
     pub fn prim_ids(&self) -> &'a [u32] {
         self.prim_ids
     }
-    /// The primitives.
+    /// The primitives (in leaf order after [`Bvh::build_in_leaf_order`]).
     #[must_use]
     pub fn prims(&self) -> &'a [P] {
         self.prims

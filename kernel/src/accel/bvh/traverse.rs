@@ -7,19 +7,25 @@ use crate::scalar::Scalar;
 
 impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
     /// Walks the tree. With `ANY`, returns at the first hit in range; otherwise finds the
-    /// closest under [`closer`]. Returns (t, prim) of the hit, `prim == u32::MAX` for none.
+    /// closest under [`closer`]. Returns (t, prim id, index into `prims`) of the hit;
+    /// `prim id == u32::MAX` for none.
     #[inline(always)]
-    fn traverse<const ANY: bool, C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> (S, u32) {
+    fn traverse<const ANY: bool, C: Counters>(
+        &self,
+        ray: &Ray<S>,
+        stats: &mut C,
+    ) -> (S, u32, usize) {
         let rd = ray.data();
         let t_min = ray.t_min();
         let mut best_t = ray.t_max();
         let mut best_prim = u32::MAX;
+        let mut best_at = 0usize;
         let Some(root) = self.nodes.first() else {
-            return (best_t, best_prim);
+            return (best_t, best_prim, best_at);
         };
         stats.node();
         if S::slab(rd, &root.lo, &root.hi, t_min, best_t).is_none() {
-            return (best_t, best_prim);
+            return (best_t, best_prim, best_at);
         }
         // Each level below the root pushes at most one entry, and leaves are at most
         // MAX_DEPTH deep, so the stack cannot overflow.
@@ -33,24 +39,26 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                     .prim_ids
                     .get(first..first + node.count as usize)
                     .unwrap_or_default();
-                for &id in ids {
-                    let Some(prim) = self.prims.get(id as usize) else {
+                for (slot, &id) in (first..).zip(ids) {
+                    let at = if self.leaf_order { slot } else { id as usize };
+                    let Some(prim) = self.prims.get(at) else {
                         continue;
                     };
                     stats.prim();
                     if let Some(t) = prim.hit_t(rd, t_min, best_t) {
                         if ANY {
-                            return (t, id);
+                            return (t, id, at);
                         }
                         if closer(t, id, best_t, best_prim) {
                             best_t = t;
                             best_prim = id;
+                            best_at = at;
                         }
                     }
                 }
             } else {
                 let l = node.first as usize;
-                if let (Some(a), Some(b)) = (self.nodes.get(l), self.nodes.get(l + 1)) {
+                if let Some([a, b]) = self.nodes.get(l..l + 2) {
                     stats.node();
                     stats.node();
                     let ta = S::slab(rd, &a.lo, &a.hi, t_min, best_t);
@@ -93,14 +101,17 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                 }
             }
         }
-        (best_t, best_prim)
+        (best_t, best_prim, best_at)
     }
 }
 
 impl<S: Scalar, P: Primitive<S>> Accel<S> for Bvh<'_, S, P> {
     fn intersect_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Hit<S>> {
-        let (t, prim) = self.traverse::<false, C>(ray, stats);
-        let p = self.prims.get(prim as usize)?;
+        let (t, prim, at) = self.traverse::<false, C>(ray, stats);
+        if prim == u32::MAX {
+            return None;
+        }
+        let p = self.prims.get(at)?;
         let (u, v) = p.hit_uv(ray.data());
         Some(Hit { t, prim, u, v })
     }

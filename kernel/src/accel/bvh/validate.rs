@@ -102,8 +102,9 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                 next_first = first + count;
                 stats.leaf_count += 1;
                 stats.max_leaf_size = stats.max_leaf_size.max(node.count);
-                for &id in &self.prim_ids[first..first + count] {
-                    let Some(p) = self.prims.get(id as usize) else {
+                for (slot, &id) in (first..).zip(&self.prim_ids[first..first + count]) {
+                    let at = if self.leaf_order { slot } else { id as usize };
+                    let Some(p) = self.prims.get(at) else {
                         return Err(InvalidTree::BadPrimIds { prim: id });
                     };
                     if !node.bounds().contains(&p.bounds()) {
