@@ -265,7 +265,9 @@ pub fn parse_obj(bytes: &[u8], path_for_errors: &Path) -> Result<Mesh, ObjError>
         }
     }
     if mesh.triangles.is_empty() {
-        return Err(err(line_no, ObjErrorKind::NoTriangles));
+        // The last line: a final newline ends it rather than starting another.
+        let last = line_no - usize::from(line_no > 1 && bytes.ends_with(b"\n"));
+        return Err(err(last, ObjErrorKind::NoTriangles));
     }
     // Positive indices may point forward; check them now that every vertex is known.
     let vertex_count = mesh.positions.len();

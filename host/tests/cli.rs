@@ -1,0 +1,219 @@
+//! The `host` binary: bad files and arguments give one message on stderr and a non-zero exit,
+//! never a panic; a good run prints its JSON report as the last stdout line.
+
+mod common;
+
+use common::{icosphere, random_rays, temp_dir, Rng};
+use host::rayfile::{write_hits, write_rays};
+use host::HitRecord;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn host(args: &[&Path]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_host"))
+        .args(args)
+        .output()
+        .expect("run the host binary")
+}
+
+fn p(s: &str) -> PathBuf {
+    PathBuf::from(s)
+}
+
+/// Valid scene and ray files in a fresh directory.
+fn fixture(name: &str) -> (PathBuf, PathBuf, PathBuf) {
+    let dir = temp_dir(name);
+    let obj = dir.join("s.obj");
+    std::fs::write(&obj, icosphere([0.0; 3], 1.0, 1).to_obj()).unwrap();
+    let rays = dir.join("s.rays");
+    write_rays(
+        &rays,
+        &random_rays(&mut Rng::new(3), [-2.0; 3], [2.0; 3], 50),
+    )
+    .unwrap();
+    (dir, obj, rays)
+}
+
+/// Asserts a clean failure: exit code, no stdout, one stderr line containing `needle`.
+fn assert_fails(out: &Output, code: i32, needle: &str) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(code), "stderr: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(stderr.contains(needle), "expected {needle:?} in: {stderr}");
+    assert!(
+        out.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+}
+
+#[test]
+fn trace_prints_a_json_report_as_the_last_line() {
+    let (dir, obj, rays) = fixture("cli_ok");
+    let hits = dir.join("s.hits");
+    let out = host(&[
+        &p("trace"),
+        &obj,
+        &rays,
+        &p("--out"),
+        &hits,
+        &p("--mode"),
+        &p("fixed"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let last = stdout.lines().last().unwrap();
+    let v: serde_json::Value = serde_json::from_str(last).unwrap();
+    for key in [
+        "scene",
+        "rays_file",
+        "accel",
+        "builder",
+        "mode",
+        "leaf",
+        "stride",
+        "triangles",
+        "build_ms",
+        "trace_ms",
+        "rays",
+        "mrays_per_s",
+        "hits",
+        "bad_rays",
+        "nodes",
+        "bytes_per_tri",
+        "depth",
+    ] {
+        assert!(v.get(key).is_some(), "{key} missing from {last}");
+    }
+    assert_eq!(v["accel"], "bvh");
+    assert_eq!(v["builder"], "sah");
+    assert_eq!(v["mode"], "fixed");
+    assert_eq!(v["triangles"], 80);
+    assert_eq!(v["rays"], 50);
+    assert_eq!(std::fs::metadata(&hits).unwrap().len(), 50 * 8);
+
+    let same = host(&[&p("compare-hits"), &hits, &hits]);
+    assert!(same.status.success());
+    let v: serde_json::Value =
+        serde_json::from_str(String::from_utf8(same.stdout).unwrap().trim()).unwrap();
+    assert_eq!(v["n"], 50);
+    assert_eq!(v["same_prim_pct"], 100.0);
+    assert_eq!(v["hitmiss"], 0);
+}
+
+#[test]
+fn missing_scene_or_rays_fail_cleanly() {
+    let (dir, obj, rays) = fixture("cli_missing");
+    let hits = dir.join("x.hits");
+    let none = dir.join("none.obj");
+    let out = host(&[&p("trace"), &none, &rays, &p("--out"), &hits]);
+    assert_fails(&out, 1, "none.obj: cannot read");
+    let none = dir.join("none.rays");
+    let out = host(&[&p("trace"), &obj, &none, &p("--out"), &hits]);
+    assert_fails(&out, 1, "none.rays: cannot read");
+    let out = host(&[
+        &p("trace"),
+        &obj,
+        &rays,
+        &p("--out"),
+        &dir.join("no/dir.hits"),
+    ]);
+    assert_fails(&out, 1, "dir.hits: cannot write");
+}
+
+#[test]
+fn bad_obj_names_its_line() {
+    let (dir, _, rays) = fixture("cli_bad_obj");
+    let obj = dir.join("bad.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").unwrap();
+    let out = host(&[&p("trace"), &obj, &rays, &p("--out"), &dir.join("x.hits")]);
+    assert_fails(&out, 1, "bad.obj:4: vertex index 7 out of range");
+    std::fs::write(&obj, b"\xff\xfe garbage\x00\n").unwrap();
+    let out = host(&[&p("trace"), &obj, &rays, &p("--out"), &dir.join("x.hits")]);
+    assert_fails(&out, 1, "bad.obj:1: no faces");
+    // Representable in f32, not in fixed point.
+    std::fs::write(&obj, "v 0 0 0\nv 10000 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let out = host(&[
+        &p("trace"),
+        &obj,
+        &rays,
+        &p("--out"),
+        &dir.join("x.hits"),
+        &p("--mode"),
+        &p("fixed"),
+    ]);
+    assert_fails(&out, 1, "bad.obj:2: vertex unusable in fixed mode");
+}
+
+#[test]
+fn ray_file_of_wrong_length_is_rejected() {
+    let (dir, obj, _) = fixture("cli_bad_rays");
+    let rays = dir.join("short.rays");
+    std::fs::write(&rays, [0u8; 100]).unwrap();
+    let out = host(&[&p("trace"), &obj, &rays, &p("--out"), &dir.join("x.hits")]);
+    assert_fails(
+        &out,
+        1,
+        "short.rays: not a ray file: length 100 bytes is not a multiple of 32",
+    );
+}
+
+#[test]
+fn bad_arguments_are_usage_errors() {
+    let (dir, obj, rays) = fixture("cli_bad_args");
+    let hits = dir.join("x.hits");
+    let base = [
+        &p("trace"),
+        obj.as_path(),
+        rays.as_path(),
+        &p("--out"),
+        hits.as_path(),
+    ];
+    for (extra, needle) in [
+        (
+            vec!["--mode", "double"],
+            "invalid value 'double' for '--mode",
+        ),
+        (vec!["--accel", "grid"], "invalid value 'grid'"),
+        (vec!["--builder", "lbvh"], "invalid value 'lbvh'"),
+        (vec!["--leaf", "0"], "--leaf"),
+        (vec!["--leaf", "65"], "--leaf"),
+        (vec!["--stride", "0"], "--stride"),
+        (vec!["--stride=-3"], "--stride"),
+        (vec!["--bogus"], "unexpected argument '--bogus'"),
+    ] {
+        let extra: Vec<PathBuf> = extra.into_iter().map(p).collect();
+        let args: Vec<&Path> = base
+            .iter()
+            .copied()
+            .chain(extra.iter().map(|e| e.as_path()))
+            .collect();
+        assert_fails(&host(&args), 2, needle);
+    }
+    // --out is required.
+    assert_fails(&host(&[&p("trace"), &obj, &rays]), 2, "--out");
+    assert_fails(&host(&[&p("render")]), 2, "unrecognized subcommand");
+}
+
+#[test]
+fn compare_hits_rejects_files_of_different_lengths() {
+    let dir = temp_dir("cli_compare");
+    let (a, b) = (dir.join("a.hits"), dir.join("b.hits"));
+    write_hits(&a, &[HitRecord::MISS; 3]).unwrap();
+    write_hits(&b, &[HitRecord::MISS; 4]).unwrap();
+    assert_fails(
+        &host(&[&p("compare-hits"), &a, &b]),
+        1,
+        "a.hits has 3 records",
+    );
+    std::fs::write(&b, [0u8; 7]).unwrap();
+    assert_fails(
+        &host(&[&p("compare-hits"), &a, &b]),
+        1,
+        "not a multiple of 8",
+    );
+}

@@ -1,0 +1,234 @@
+//! Helpers shared by the integration tests: a seeded RNG, scene and ray generators, temp dirs.
+#![allow(dead_code)]
+
+use host::RayRecord;
+use std::path::{Path, PathBuf};
+
+/// SplitMix64: small, seeded, good enough for test data.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Self(seed)
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [0, 1).
+    pub fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    /// Uniform in [lo, hi).
+    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.unit()
+    }
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next_u64() % n as u64) as usize
+    }
+    /// Uniform on the unit sphere.
+    pub fn direction(&mut self) -> [f32; 3] {
+        let z = 1.0 - 2.0 * self.unit();
+        let phi = 2.0 * std::f64::consts::PI * self.unit();
+        let s = (1.0 - z * z).max(0.0).sqrt();
+        [(s * phi.cos()) as f32, (s * phi.sin()) as f32, z as f32]
+    }
+}
+
+/// A fresh, empty directory under the integration tests' temp dir.
+pub fn temp_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A closed triangle mesh: an icosahedron subdivided `levels` times, projected on a sphere.
+pub struct Sphere {
+    pub positions: Vec<[f64; 3]>,
+    pub triangles: Vec<[usize; 3]>,
+}
+
+pub fn icosphere(center: [f64; 3], radius: f64, levels: u32) -> Sphere {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut p: Vec<[f64; 3]> = vec![
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ];
+    let mut tris: Vec<[usize; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..levels {
+        let mut mid = std::collections::HashMap::new();
+        let mut next = Vec::with_capacity(tris.len() * 4);
+        for [a, b, c] in tris {
+            let mut m = |i: usize, j: usize| {
+                *mid.entry((i.min(j), i.max(j))).or_insert_with(|| {
+                    p.push([
+                        (p[i][0] + p[j][0]) / 2.0,
+                        (p[i][1] + p[j][1]) / 2.0,
+                        (p[i][2] + p[j][2]) / 2.0,
+                    ]);
+                    p.len() - 1
+                })
+            };
+            let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        tris = next;
+    }
+    let positions = p
+        .iter()
+        .map(|v| {
+            let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            [
+                center[0] + radius * v[0] / len,
+                center[1] + radius * v[1] / len,
+                center[2] + radius * v[2] / len,
+            ]
+        })
+        .collect();
+    Sphere {
+        positions,
+        triangles: tris,
+    }
+}
+
+impl Sphere {
+    /// Vertex positions rounded to f32, as the OBJ file holds them.
+    pub fn positions_f32(&self) -> Vec<[f32; 3]> {
+        self.positions.iter().map(|p| p.map(|x| x as f32)).collect()
+    }
+
+    /// OBJ text: `v` lines (f32 printed round-trip exact), then one `f` line per triangle.
+    pub fn to_obj(&self) -> String {
+        let mut s = String::from("# icosphere\n");
+        for p in self.positions_f32() {
+            s += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+        }
+        for t in &self.triangles {
+            s += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+        }
+        s
+    }
+}
+
+/// Pinhole camera as in `shared/bench/WORKLOAD.md` (`NAME.camera`).
+pub struct Camera {
+    pub eye: [f64; 3],
+    pub target: [f64; 3],
+    pub up: [f64; 3],
+    pub vfov_deg: f64,
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn normalize(a: [f64; 3]) -> [f64; 3] {
+    let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    a.map(|x| x / l)
+}
+
+impl Camera {
+    /// Parses `eye`, `target`, `up` and `vfov` lines (`#` starts a comment).
+    pub fn parse(text: &str) -> Self {
+        let mut cam = Camera {
+            eye: [0.0; 3],
+            target: [0.0; 3],
+            up: [0.0; 3],
+            vfov_deg: 0.0,
+        };
+        for line in text.lines() {
+            let line = line.split('#').next().unwrap_or_default();
+            let mut it = line.split_whitespace();
+            let Some(key) = it.next() else { continue };
+            let nums: Vec<f64> = it.map(|x| x.parse().unwrap()).collect();
+            match key {
+                "eye" => cam.eye = [nums[0], nums[1], nums[2]],
+                "target" => cam.target = [nums[0], nums[1], nums[2]],
+                "up" => cam.up = [nums[0], nums[1], nums[2]],
+                "vfov" => cam.vfov_deg = nums[0],
+                _ => panic!("unknown camera key {key}"),
+            }
+        }
+        cam
+    }
+
+    /// The ray through the centre of pixel (`px`, `py`) of a `size`×`size` image.
+    pub fn ray(&self, px: usize, py: usize, size: usize) -> RayRecord {
+        let fwd = normalize(sub(self.target, self.eye));
+        let right = normalize(cross(fwd, self.up));
+        let cup = cross(right, fwd);
+        let h = (self.vfov_deg.to_radians() * 0.5).tan();
+        let u = ((px as f64 + 0.5) / size as f64 * 2.0 - 1.0) * h;
+        let v = (1.0 - (py as f64 + 0.5) / size as f64 * 2.0) * h;
+        let d = normalize([
+            fwd[0] + u * right[0] + v * cup[0],
+            fwd[1] + u * right[1] + v * cup[1],
+            fwd[2] + u * right[2] + v * cup[2],
+        ]);
+        RayRecord::new(self.eye.map(|x| x as f32), d.map(|x| x as f32))
+    }
+}
+
+/// Bounding box of points.
+pub fn bbox(points: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (lo, hi)
+}
+
+/// Rays with origins uniform in the box and uniform directions.
+pub fn random_rays(rng: &mut Rng, lo: [f32; 3], hi: [f32; 3], n: usize) -> Vec<RayRecord> {
+    (0..n)
+        .map(|_| {
+            let o = [0, 1, 2].map(|k| rng.range(f64::from(lo[k]), f64::from(hi[k])) as f32);
+            RayRecord::new(o, rng.direction())
+        })
+        .collect()
+}
