@@ -179,10 +179,10 @@ pub struct FixedRay {
     dir: [i64; 3],
     /// `2^62 / dir` truncated (`i64::MAX` for a zero component).
     recip: [i64; 3],
-    /// Origin as seen from the boxes' `lo` planes, moved one raw unit so the distance to the
-    /// nearer of the two planes is never overestimated and to the farther never underestimated.
+    /// Origin as seen from the boxes' `lo` planes: one raw unit up, so every box grows by one
+    /// unit downwards (and a zero-direction origin on a plane is strictly inside the slab).
     o_lo: [i64; 3],
-    /// Origin as seen from the boxes' `hi` planes.
+    /// Origin as seen from the boxes' `hi` planes: one raw unit down.
     o_hi: [i64; 3],
 }
 
@@ -211,12 +211,12 @@ impl FixedRay {
         for i in 0..3 {
             let o = origin[i].0 as i64;
             let d = libm::round(unit[i] * DIR_ONE) as i64;
-            let s = if d < 0 { -1 } else { 1 };
             r.origin[i] = o;
             r.dir[i] = d;
             r.recip[i] = if d == 0 { i64::MAX } else { (1i64 << 62) / d };
-            r.o_lo[i] = o + s;
-            r.o_hi[i] = o - s;
+            // The box grows by one raw unit on each side, as seen from these origins.
+            r.o_lo[i] = o + 1;
+            r.o_hi[i] = o - 1;
         }
         Ok(r)
     }

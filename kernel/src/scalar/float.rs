@@ -25,10 +25,11 @@ pub struct FloatRay {
     dir: [f32; 3],
     /// `1 / dir`, `±inf` for `±0` components (sign preserved, never NaN).
     inv: [f32; 3],
-    /// Origin as seen from the boxes' `lo` planes, moved so that the distance to whichever of
-    /// the two planes is nearer is never overestimated, and to the farther never underestimated.
+    /// Origin as seen from the boxes' `lo` planes: moved up by the margin, which enlarges
+    /// every box downwards, so near distances are never overestimated nor far ones
+    /// underestimated.
     o_lo: [f32; 3],
-    /// Origin as seen from the boxes' `hi` planes (see `o_lo`).
+    /// Origin as seen from the boxes' `hi` planes: moved down by the margin.
     o_hi: [f32; 3],
     /// Watertight test: axis permutation (kx, ky, kz), each < 3; kept as indices into `[f32; 4]`.
     k: [usize; 3],
@@ -86,9 +87,10 @@ pub(super) fn unit_dir_f64(d: [f64; 3]) -> Result<[f64; 3], RayError> {
     if m == 0.0 {
         return Err(RayError::ZeroDirection);
     }
-    let s = [d[0] / m, d[1] / m, d[2] / m];
-    let len = libm::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-    Ok([s[0] / len, s[1] / len, s[2] / len])
+    let inv_m = 1.0 / m;
+    let s = [d[0] * inv_m, d[1] * inv_m, d[2] * inv_m];
+    let inv_len = 1.0 / libm::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    Ok([s[0] * inv_len, s[1] * inv_len, s[2] * inv_len])
 }
 
 impl FloatRay {
@@ -106,13 +108,11 @@ impl FloatRay {
         let mut o_hi = [0.0; 3];
         for i in 0..3 {
             inv[i] = 1.0 / dir[i];
-            // For a positive (or +0) direction `lo` is the near plane: moving the origin up
-            // shrinks its distance; `hi` is the far one: moving down grows it. Mirrored for
-            // negative. A zero component gets both shifts, so an origin inside the slab sees
-            // `-inf` and `+inf`.
-            let up = !dir[i].is_sign_negative();
-            o_lo[i] = shift(origin[i], delta, up);
-            o_hi[i] = shift(origin[i], delta, !up);
+            // Seen from shifted origins the box grows by `delta` on each side, whichever plane
+            // is near: `lo - (o + delta)` and `hi - (o - delta)`. For a zero component an origin
+            // inside the slab then sees `-inf` and `+inf`, never `0 * inf`.
+            o_lo[i] = shift(origin[i], delta, true);
+            o_hi[i] = shift(origin[i], delta, false);
         }
 
         // Watertight test: kz is the dominant axis; swapping kx/ky keeps the winding.
@@ -129,7 +129,8 @@ impl FloatRay {
         if dir[kz] < 0.0 {
             core::mem::swap(&mut kx, &mut ky);
         }
-        let shear = [dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]];
+        let sz = 1.0 / dir[kz];
+        let shear = [dir[kx] * sz, dir[ky] * sz, sz];
         Ok(Self {
             origin,
             dir,
@@ -161,6 +162,29 @@ impl FloatRay {
         [p[kx] - sx * p[kz], p[ky] - sy * p[kz], sz * p[kz]]
     }
 
+    /// True if the point at `t` lies in the triangle's box grown by half the traversal margin.
+    ///
+    /// A hit the watertight test reports on a well-conditioned triangle always passes. One on a
+    /// nearly edge-on sliver can carry a `t` far off (det is tiny); rejecting it keeps every
+    /// reported hit inside the boxes traversal tests, so no accelerator can cull a hit that
+    /// brute force would report.
+    #[inline]
+    fn point_near_box(&self, t: f32, v: &[[f32; 3]; 3]) -> bool {
+        let mut m = abs(self.origin[0])
+            .max_of(abs(self.origin[1]))
+            .max_of(abs(self.origin[2]));
+        for p in v {
+            m = m.max_of(abs(p[0])).max_of(abs(p[1])).max_of(abs(p[2]));
+        }
+        let e = m * (MARGIN * 0.5);
+        (0..3).all(|i| {
+            let p = self.origin[i] + t * self.dir[i];
+            let lo = v[0][i].min_of(v[1][i]).min_of(v[2][i]);
+            let hi = v[0][i].max_of(v[1][i]).max_of(v[2][i]);
+            p >= lo - e && p <= hi + e
+        })
+    }
+
     /// The three edge functions (U, V, W) of the sheared triangle, with the exact `f64`
     /// recomputation when any is zero (f32 products are exact in f64, so the sign is exact).
     #[inline(always)]
@@ -176,6 +200,16 @@ impl FloatRay {
         }
         [u, v, w]
     }
+}
+
+/// True if the triangle has exactly zero area: `(b - a) × (c - a) = 0`, evaluated in `f64`
+/// (differences of `f32` coordinates of similar magnitude and their products are exact there).
+fn zero_area(v: &[[f32; 3]; 3]) -> bool {
+    let e1: [f64; 3] = core::array::from_fn(|i| v[1][i] as f64 - v[0][i] as f64);
+    let e2: [f64; 3] = core::array::from_fn(|i| v[2][i] as f64 - v[0][i] as f64);
+    e1[1] * e2[2] == e1[2] * e2[1]
+        && e1[2] * e2[0] == e1[0] * e2[2]
+        && e1[0] * e2[1] == e1[1] * e2[0]
 }
 
 impl Scalar for f32 {
@@ -294,11 +328,14 @@ impl Scalar for f32 {
         }
         // Scaled hit distance. NaN (only from overflow) fails the range test.
         let t = (eu * a[2] + ev * b[2] + ew * c[2]) / det;
-        if t >= t_min && t <= t_max {
-            Some(t)
-        } else {
-            None
+        if !(t >= t_min && t <= t_max) {
+            return None;
         }
+        // Rare path, hits only: drop what rounding made of degenerate or edge-on triangles.
+        if !r.point_near_box(t, v) || zero_area(v) {
+            return None;
+        }
+        Some(t)
     }
 
     fn triangle_uv(r: &FloatRay, v: &[[f32; 3]; 3]) -> (f32, f32) {
@@ -343,9 +380,12 @@ impl Scalar for f32 {
         }
         let (t0, t1) = (c / q, q / a);
         let (near, far) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
-        if near >= t_min && near <= t_max {
+        let (lo, hi) = Self::sphere_bounds(center, radius);
+        let box_ = [lo, hi, hi];
+        let ok = |t: f32| t >= t_min && t <= t_max && r.point_near_box(t, &box_);
+        if ok(near) {
             Some(near)
-        } else if far >= t_min && far <= t_max {
+        } else if ok(far) {
             Some(far)
         } else {
             None

@@ -68,7 +68,24 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
         kind: options.builder,
         _scalar: core::marker::PhantomData,
     };
-    let root = builder.summarize(ids);
+    // Bounds cache: while it is valid, slot `n + pos` of the arena holds the bounds and id of
+    // the primitive at position `pos` (a one-primitive leaf), and the builder partitions these
+    // slots instead of ids: sequential reads instead of recomputing scattered primitives.
+    // Nodes are allocated left to right and every position left of the current node is
+    // final, so the cache stays intact while `used + 2 <= n + first`; when a split would break
+    // that, the ids are written back and the build goes on from the primitives themselves.
+    let mut cached = n >= 2;
+    if cached {
+        for (pos, slot) in nodes[n..2 * n].iter_mut().enumerate() {
+            let bounds = builder.prim(pos as u32);
+            *slot = Node::leaf(bounds, pos as u32, 1);
+        }
+    }
+    let root = if cached {
+        builder.summarize(&nodes[n..2 * n])
+    } else {
+        builder.summarize(ids)
+    };
     nodes[0] = Node::leaf(root.bounds, 0, n as u32);
     let mut used = 1usize;
     if n > 1 {
@@ -94,11 +111,30 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
         let node = nodes[index as usize];
         let (first, count) = (node.first as usize, node.count as usize);
         deepest = deepest.max(depth);
-        let Some(range) = ids.get_mut(first..first + count) else {
-            continue;
+        if cached && used + 2 > n + first {
+            for (id, slot) in ids[first..].iter_mut().zip(&nodes[n + first..2 * n]) {
+                *id = slot.first;
+            }
+            cached = false;
+        }
+        let split = if cached {
+            let range = &mut nodes[n + first..n + first + count];
+            let split = builder.split(range, depth as usize, &centroids, &mut bins);
+            if split.is_none() {
+                for (id, slot) in ids[first..first + count].iter_mut().zip(range.iter()) {
+                    *id = slot.first;
+                }
+            }
+            split
+        } else {
+            builder.split(
+                &mut ids[first..first + count],
+                depth as usize,
+                &centroids,
+                &mut bins,
+            )
         };
-        let Some([left, right]) = builder.split(range, depth as usize, &centroids, &mut bins)
-        else {
+        let Some([left, right]) = split else {
             continue;
         };
         let l = used;
@@ -205,6 +241,39 @@ fn lowest<S: Scalar>() -> S {
     S::from_f32_saturating(f32::NEG_INFINITY)
 }
 
+/// What the builder partitions: primitive ids, or cached (bounds, id) slots.
+trait Slot<S: Scalar>: Copy {
+    /// The primitive's id.
+    fn id(&self) -> u32;
+    /// The primitive's box, from the cache or recomputed.
+    fn bounds<P: Primitive<S>>(&self, prims: &[P]) -> Aabb<S>;
+}
+
+impl<S: Scalar> Slot<S> for u32 {
+    #[inline(always)]
+    fn id(&self) -> u32 {
+        *self
+    }
+    #[inline(always)]
+    fn bounds<P: Primitive<S>>(&self, prims: &[P]) -> Aabb<S> {
+        match prims.get(*self as usize) {
+            Some(p) => p.bounds(),
+            None => empty_box(),
+        }
+    }
+}
+
+impl<S: Scalar> Slot<S> for Node<S> {
+    #[inline(always)]
+    fn id(&self) -> u32 {
+        self.first
+    }
+    #[inline(always)]
+    fn bounds<P: Primitive<S>>(&self, _prims: &[P]) -> Aabb<S> {
+        Aabb::new(self.lo, self.hi)
+    }
+}
+
 impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
     fn prim(&self, id: u32) -> Aabb<S> {
         match self.prims.get(id as usize) {
@@ -214,20 +283,24 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
     }
 
     /// Count, box and centroid bounds of `ids`.
-    fn summarize(&self, ids: &[u32]) -> Side<S> {
+    fn summarize<T: Slot<S>>(&self, ids: &[T]) -> Side<S> {
         let mut side = Side::empty();
-        for &id in ids {
-            side.add(&self.prim(id));
+        for id in ids {
+            side.add(&id.bounds(self.prims));
         }
         side
     }
 
     /// Partitions `ids` by `left`, summarizing both sides on the way.
-    fn partition_by(&self, ids: &mut [u32], left: impl Fn(&Aabb<S>) -> bool) -> [Side<S>; 2] {
+    fn partition_by<T: Slot<S>>(
+        &self,
+        ids: &mut [T],
+        left: impl Fn(&Aabb<S>) -> bool,
+    ) -> [Side<S>; 2] {
         let mut sides = [Side::empty(), Side::empty()];
         let (mut i, mut j) = (0, ids.len());
         while i < j {
-            let b = self.prim(ids[i]);
+            let b = ids[i].bounds(self.prims);
             if left(&b) {
                 sides[0].add(&b);
                 i += 1;
@@ -241,9 +314,9 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
     }
 
     /// Decides whether and where to split `ids` (partitioning them); `None` makes a leaf.
-    fn split(
+    fn split<T: Slot<S>>(
         &self,
-        ids: &mut [u32],
+        ids: &mut [T],
         depth: usize,
         centroids: &Centroids,
         bins: &mut Bins<S>,
@@ -283,18 +356,18 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         }
     }
 
-    fn median(&self, ids: &mut [u32], axis: usize) -> [Side<S>; 2] {
+    fn median<T: Slot<S>>(&self, ids: &mut [T], axis: usize) -> [Side<S>; 2] {
         let mid = ids.len() / 2;
-        select_nth(ids, mid, |id| key(&self.prim(id), axis));
+        select_nth(ids, mid, |id| (key(&id.bounds(self.prims), axis), id.id()));
         let (left, right) = ids.split_at(mid);
         [self.summarize(left), self.summarize(right)]
     }
 
     /// Binned SAH over all three axes. `None` when a leaf is cheaper (and allowed) or no axis
     /// separates the centroids.
-    fn sah(
+    fn sah<T: Slot<S>>(
         &self,
-        ids: &mut [u32],
+        ids: &mut [T],
         clo: &[f32; 3],
         extent: &[f32; 3],
         bins: &mut Bins<S>,
@@ -323,8 +396,8 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
                 nb - 1
             }
         };
-        for &id in ids.iter() {
-            let b = self.prim(id);
+        for id in ids.iter() {
+            let b = id.bounds(self.prims);
             for (a, axis_bins) in bins.iter_mut().enumerate() {
                 let bin = &mut axis_bins[bin_of(key(&b, a), a)];
                 bin.0 = bin.0.union(&b);

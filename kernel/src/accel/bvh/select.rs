@@ -1,11 +1,11 @@
-//! In-place, allocation-free, panic-free partitioning of primitive ids.
+//! In-place, allocation-free, panic-free partitioning of primitive slots.
 
 /// Reorders `ids` so those with `left(id)` come first; returns how many there are.
-pub(super) fn partition(ids: &mut [u32], mut left: impl FnMut(u32) -> bool) -> usize {
+pub(super) fn partition<T: Copy>(ids: &mut [T], mut left: impl FnMut(&T) -> bool) -> usize {
     let mut i = 0;
     let mut j = ids.len();
     while i < j {
-        if left(ids[i]) {
+        if left(&ids[i]) {
             i += 1;
         } else {
             j -= 1;
@@ -15,17 +15,18 @@ pub(super) fn partition(ids: &mut [u32], mut left: impl FnMut(u32) -> bool) -> u
     i
 }
 
-/// The strict total order used for median splits: by key, then by id (ids are distinct).
+/// The strict total order used for median splits: `key` gives (key, id), ids are distinct.
 #[inline]
-fn less(key: &impl Fn(u32) -> f32, a: u32, b: u32) -> bool {
-    let (ka, kb) = (key(a), key(b));
-    ka < kb || (ka == kb && a < b)
+fn less<T>(key: &impl Fn(&T) -> (f32, u32), a: &T, b: &T) -> bool {
+    let (ka, ia) = key(a);
+    let (kb, ib) = key(b);
+    ka < kb || (ka == kb && ia < ib)
 }
 
 /// Reorders `ids` so that the first `nth` are the `nth` smallest under (key, id).
 /// Quickselect with a median-of-three pivot; after `2·log2(n)` rounds it falls back to
 /// heapsort of what is left, so the worst case stays `O(n log n)`. Keys must not be NaN.
-pub(super) fn select_nth(ids: &mut [u32], nth: usize, key: impl Fn(u32) -> f32) {
+pub(super) fn select_nth<T: Copy>(ids: &mut [T], nth: usize, key: impl Fn(&T) -> (f32, u32)) {
     let (mut lo, mut hi) = (0usize, ids.len());
     let mut budget = 2 * (usize::BITS - ids.len().leading_zeros());
     while hi - lo > 1 && nth > lo && nth < hi {
@@ -36,7 +37,7 @@ pub(super) fn select_nth(ids: &mut [u32], nth: usize, key: impl Fn(u32) -> f32) 
         budget -= 1;
         // Median of three as pivot, moved to the end.
         let mid = lo + (hi - lo) / 2;
-        let (a, b, c) = (ids[lo], ids[mid], ids[hi - 1]);
+        let (a, b, c) = (&ids[lo], &ids[mid], &ids[hi - 1]);
         let p = if less(&key, a, b) == less(&key, b, c) {
             mid
         } else if less(&key, b, a) == less(&key, a, c) {
@@ -46,7 +47,7 @@ pub(super) fn select_nth(ids: &mut [u32], nth: usize, key: impl Fn(u32) -> f32) 
         };
         ids.swap(p, hi - 1);
         let pivot = ids[hi - 1];
-        let split = lo + partition(&mut ids[lo..hi - 1], |id| less(&key, id, pivot));
+        let split = lo + partition(&mut ids[lo..hi - 1], |id| less(&key, id, &pivot));
         ids.swap(split, hi - 1);
         // ids[lo..split] < pivot = ids[split] < ids[split + 1..hi]
         if nth <= split {
@@ -57,16 +58,16 @@ pub(super) fn select_nth(ids: &mut [u32], nth: usize, key: impl Fn(u32) -> f32) 
     }
 }
 
-fn heapsort(v: &mut [u32], key: &impl Fn(u32) -> f32) {
-    let sift = |v: &mut [u32], mut root: usize, end: usize| loop {
+fn heapsort<T: Copy>(v: &mut [T], key: &impl Fn(&T) -> (f32, u32)) {
+    let sift = |v: &mut [T], mut root: usize, end: usize| loop {
         let mut child = 2 * root + 1;
         if child >= end {
             break;
         }
-        if child + 1 < end && less(key, v[child], v[child + 1]) {
+        if child + 1 < end && less(key, &v[child], &v[child + 1]) {
             child += 1;
         }
-        if !less(key, v[root], v[child]) {
+        if !less(key, &v[root], &v[child]) {
             break;
         }
         v.swap(root, child);
@@ -91,7 +92,7 @@ mod tests {
         let keys = [5.0f32, 1.0, 3.0, 3.0, 9.0, 0.0, 3.0, 7.0];
         for nth in 0..=keys.len() {
             let mut ids: [u32; 8] = core::array::from_fn(|i| i as u32);
-            select_nth(&mut ids, nth, |i| keys[i as usize]);
+            select_nth(&mut ids, nth, |&i| (keys[i as usize], i));
             let mut sorted: [u32; 8] = core::array::from_fn(|i| i as u32);
             sorted.sort_by(|&a, &b| {
                 keys[a as usize]
@@ -110,7 +111,7 @@ mod tests {
     fn heapsort_sorts() {
         let keys = [4.0f32, 4.0, 2.0, 8.0, 1.0];
         let mut ids = [0u32, 1, 2, 3, 4];
-        heapsort(&mut ids, &|i| keys[i as usize]);
+        heapsort(&mut ids, &|&i| (keys[i as usize], i));
         assert_eq!(ids, [4, 2, 0, 1, 3]);
     }
 }
