@@ -1,0 +1,118 @@
+#!/usr/bin/env bash
+# Checks `host trace` on the shared scenes: every BVH builder against brute force, byte for byte.
+#
+# usage: host/scripts/check_trace.sh RAYS_DIR
+#
+# RAYS_DIR holds NAME.primary.rays and NAME.incoherent.rays, as written by
+#   python3 ../shared/bench/make_rays.py --out RAYS_DIR bunny sponza kitchen
+#
+# For each scene, ray set and mode (f32, fixed):
+#   - traces the whole file with each builder (sah, median, midpoint) and checks the three
+#     hit files are identical;
+#   - traces every STRIDE-th ray with --accel linear and with each builder, and checks each
+#     strided BVH hit file equals the linear one (cmp);
+# then prints the fixed-vs-f32 agreement of the SAH primary hits per scene (compare-hits).
+# One summary line per run; exits non-zero if any pair of files that must match differs.
+#
+# Environment: STRIDE (default 64), SCENES (default "bunny sponza kitchen"),
+# KINDS (default "primary incoherent"), SCENES_DIR (default ../shared/scenes beside the
+# workspace), HOST_BIN (default: build and use target/release/host), OUT (directory for hit
+# files; default a temporary one, removed at the end).
+set -euo pipefail
+
+if [ $# -ne 1 ] || [ ! -d "$1" ]; then
+    echo "usage: $0 RAYS_DIR  (make it with: python3 ../shared/bench/make_rays.py --out RAYS_DIR)" >&2
+    exit 2
+fi
+rays_dir=$1
+root=$(cd "$(dirname "$0")/../.." && pwd)
+stride=${STRIDE:-64}
+scenes=${SCENES:-bunny sponza kitchen}
+kinds=${KINDS:-primary incoherent}
+scenes_dir=${SCENES_DIR:-$root/../shared/scenes}
+builders="sah median midpoint"
+modes="f32 fixed"
+
+if [ -z "${HOST_BIN:-}" ]; then
+    cargo build --quiet --release --manifest-path "$root/Cargo.toml" -p raykernel-host
+    target_dir=$(cargo metadata --format-version 1 --no-deps --manifest-path "$root/Cargo.toml" |
+        python3 -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')
+    HOST_BIN=$target_dir/release/host
+fi
+if [ -n "${OUT:-}" ]; then
+    out=$OUT
+    mkdir -p "$out"
+else
+    out=$(mktemp -d)
+    trap 'rm -rf "$out"' EXIT
+fi
+
+failures=0
+
+# trace LABEL OUT_FILE ARGS...: runs `host trace`, prints one summary line from its JSON.
+trace() {
+    local label=$1 hits=$2
+    shift 2
+    local json
+    json=$("$HOST_BIN" trace "$@" --out "$hits" | tail -n 1)
+    python3 -c '
+import json, sys
+r = json.loads(sys.argv[2])
+print("%-44s rays=%-8d hits=%-8d bad=%d build=%8.1f ms trace=%9.1f ms %7.3f Mrays/s nodes=%d depth=%d B/tri=%.1f" % (
+    sys.argv[1], r["rays"], r["hits"], r["bad_rays"], r["build_ms"], r["trace_ms"],
+    r["mrays_per_s"], r["nodes"], r["depth"], r["bytes_per_tri"]))' "$label" "$json"
+}
+
+# same LABEL A B: cmp two hit files, report and count a difference.
+same() {
+    if cmp -s "$2" "$3"; then
+        printf '%-44s identical\n' "$1"
+    else
+        printf '%-44s DIFFERENT: %s\n' "$1" "$(cmp "$2" "$3" 2>&1 | head -n 1)"
+        failures=$((failures + 1))
+    fi
+}
+
+for scene in $scenes; do
+    obj=$scenes_dir/$scene.obj
+    for kind in $kinds; do
+        rays=$rays_dir/$scene.$kind.rays
+        for mode in $modes; do
+            tag=$scene.$kind.$mode
+            for b in $builders; do
+                trace "$tag $b" "$out/$tag.$b.hits" "$obj" "$rays" --mode "$mode" --builder "$b"
+            done
+            for b in median midpoint; do
+                same "$tag $b == sah (full)" "$out/$tag.$b.hits" "$out/$tag.sah.hits"
+            done
+            trace "$tag linear /$stride" "$out/$tag.linear.s$stride.hits" "$obj" "$rays" \
+                --mode "$mode" --accel linear --stride "$stride"
+            for b in $builders; do
+                trace "$tag $b /$stride" "$out/$tag.$b.s$stride.hits" "$obj" "$rays" \
+                    --mode "$mode" --builder "$b" --stride "$stride"
+                same "$tag $b == linear (/$stride)" "$out/$tag.$b.s$stride.hits" \
+                    "$out/$tag.linear.s$stride.hits"
+            done
+            # Keep only what the agreement report below needs.
+            rm -f "$out/$tag.median.hits" "$out/$tag.midpoint.hits" "$out/$tag".*.s"$stride".hits
+        done
+    done
+done
+
+case " $kinds " in
+*" primary "*)
+    echo
+    echo "fixed vs f32, SAH, primary rays (reference f32):"
+    for scene in $scenes; do
+        printf '%-10s %s\n' "$scene" "$("$HOST_BIN" compare-hits \
+            "$out/$scene.primary.f32.sah.hits" "$out/$scene.primary.fixed.sah.hits")"
+    done
+    ;;
+esac
+
+echo
+if [ "$failures" -gt 0 ]; then
+    echo "check_trace: $failures comparison(s) DIFFERENT" >&2
+    exit 1
+fi
+echo "check_trace: all BVH hit files match brute force (stride $stride) and each other"
