@@ -27,7 +27,7 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for Linear<'_, S, P> {
         for (id, prim) in (0u32..).zip(self.prims) {
             stats.prim();
             if let Some(t) = prim.hit_t(ray.data(), t_min, best_t) {
-                if best.map_or(true, |(b, _)| closer(t, id, best_t, b)) {
+                if best.is_none_or(|(b, _)| closer(t, id, best_t, b)) {
                     best_t = t;
                     best = Some((id, prim));
                 }

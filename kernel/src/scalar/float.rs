@@ -370,7 +370,8 @@ impl Scalar for f32 {
         let s = b / a;
         let l = [f[0] + s * d[0], f[1] + s * d[1], f[2] + s * d[2]];
         let disc = radius * radius - (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
-        if !(disc >= 0.0) {
+        // NaN (only from overflow) counts as a miss, like a negative discriminant.
+        if disc.is_nan() || disc < 0.0 {
             return None;
         }
         let c = f[0] * f[0] + f[1] * f[1] + f[2] * f[2] - radius * radius;

@@ -429,7 +429,7 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
                     continue;
                 }
                 let cost = half_area(&left.0) * left.1 as f32 + right_cost[i + 1];
-                if best.map_or(true, |b| cost < b.0) {
+                if best.is_none_or(|b| cost < b.0) {
                     best = Some((cost, a, i, left.0.union(&right.0)));
                 }
             }
