@@ -374,7 +374,7 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
     ) -> Option<[Side<S>; 2]> {
         let count = ids.len();
         // Small nodes use fewer bins: the same choices for less set-up work.
-        let nb = count.clamp(8, BINS);
+        let nb = count.clamp(4, BINS);
         for axis_bins in bins.iter_mut() {
             for bin in axis_bins.iter_mut().take(nb) {
                 *bin = (empty_box(), 0);
@@ -389,12 +389,9 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
             }
         });
         let bin_of = |c: f32, a: usize| -> usize {
-            let b = ((c - clo[a]) * scale[a]) as usize; // saturating cast, NaN -> 0
-            if b < nb {
-                b
-            } else {
-                nb - 1
-            }
+            // Saturating cast (NaN -> 0), then clamped: always a valid bin.
+            let b = ((c - clo[a]) * scale[a]) as i32;
+            b.clamp(0, nb as i32 - 1) as usize
         };
         for id in ids.iter() {
             let b = id.bounds(self.prims);
