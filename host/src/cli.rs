@@ -58,6 +58,13 @@ pub struct TraceArgs {
     #[arg(long, value_name = "K", default_value_t = 1,
           value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
     pub stride: usize,
+    /// Full runs (build + trace) in one process; times reported are the medians.
+    #[arg(long, value_name = "N", default_value_t = 1,
+          value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
+    pub runs: usize,
+    /// Build with the primitives permuted into leaf order (BVH only; hits keep original ids).
+    #[arg(long)]
+    pub leaf_order: bool,
 }
 
 /// `host compare-hits REF OTHER [--rel R]`.
@@ -89,19 +96,27 @@ pub struct TraceReport {
     pub mode: &'static str,
     /// Largest leaf.
     pub leaf: u32,
+    /// Primitives permuted into leaf order at build time.
+    pub leaf_order: bool,
+    /// Full runs (build + trace); the times are medians over them.
+    pub runs: usize,
     /// Ray stride.
     pub stride: usize,
     /// Triangles in the scene.
     pub triangles: usize,
-    /// Wall time of the build (0 for linear).
+    /// Median wall time of the build, leaf-order permutation included (0 for linear).
     pub build_ms: f64,
-    /// Wall time of tracing and storing every traced ray (no file I/O).
+    /// Median wall time of tracing and storing every traced ray (no file I/O).
     pub trace_ms: f64,
+    /// Build time of each run.
+    pub build_ms_runs: Vec<f64>,
+    /// Trace time of each run.
+    pub trace_ms_runs: Vec<f64>,
     /// Rays traced.
     pub rays: usize,
     /// Rays in the file.
     pub rays_in_file: usize,
-    /// Million rays per second of trace time.
+    /// Million rays per second of the median trace time.
     pub mrays_per_s: f64,
     /// Rays that hit.
     pub hits: usize,
@@ -133,6 +148,11 @@ pub fn run(cli: &Cli) -> Result<String, Error> {
 /// # Errors
 /// Bad or unreadable inputs, an unwritable output, or a build the kernel refuses.
 pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
+    if args.leaf_order && args.accel != AccelKind::Bvh {
+        return Err(Error::Usage(
+            "--leaf-order needs --accel bvh (brute force has no leaves)".into(),
+        ));
+    }
     let mesh = load_obj(&args.scene)?;
     let rays = read_rays(&args.rays)?;
     let config = TraceConfig {
@@ -143,6 +163,8 @@ pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
         },
         mode: args.mode,
         stride: args.stride,
+        runs: args.runs,
+        leaf_order: args.leaf_order,
     };
     let output = trace(&mesh, &args.scene, &rays, &config)?;
     write_hits(&args.out, &output.hits)?;
@@ -156,10 +178,14 @@ pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
         builder: (args.accel == AccelKind::Bvh).then(|| BuilderKind::from(args.builder).name()),
         mode: args.mode.name(),
         leaf: args.leaf,
+        leaf_order: args.leaf_order,
+        runs: args.runs,
         stride: args.stride,
         triangles: s.triangles,
         build_ms: s.build_ms,
         trace_ms: s.trace_ms,
+        build_ms_runs: s.build_ms_runs,
+        trace_ms_runs: s.trace_ms_runs,
         rays: s.rays,
         rays_in_file: rays.len(),
         mrays_per_s: if secs > 0.0 {

@@ -20,6 +20,17 @@ pub enum Error {
         /// Why.
         source: BuildError,
     },
+    /// Two runs of the same trace gave different hits (the kernel is meant to be deterministic).
+    RunsDiffer {
+        /// The scene.
+        scene: PathBuf,
+        /// The run (1-based) that differs from the first.
+        run: usize,
+        /// The first ray (index in the ray file) whose hit differs.
+        ray: usize,
+    },
+    /// Arguments that parse but do not go together (exit code 2, like clap's).
+    Usage(String),
     /// Two hit files to compare hold different numbers of records.
     HitCountMismatch {
         /// The reference file and its record count.
@@ -30,10 +41,14 @@ pub enum Error {
 }
 
 impl Error {
-    /// The process exit code for this error: 1 (2 is clap's, for bad arguments).
+    /// The process exit code for this error: 2 for [`Error::Usage`] (as for clap's argument
+    /// errors), 1 otherwise.
     #[must_use]
     pub fn exit_code(&self) -> u8 {
-        1
+        match self {
+            Self::Usage(_) => 2,
+            _ => 1,
+        }
     }
 }
 
@@ -45,6 +60,12 @@ impl fmt::Display for Error {
             Self::Build { scene, source } => {
                 write!(f, "{}: cannot build the BVH: {source}", scene.display())
             }
+            Self::RunsDiffer { scene, run, ray } => write!(
+                f,
+                "{}: run {run} gave different hits from run 1 (first at ray {ray})",
+                scene.display()
+            ),
+            Self::Usage(msg) => f.write_str(msg),
             Self::HitCountMismatch { reference, other } => write!(
                 f,
                 "hit files differ in length: {} has {} records, {} has {}",
@@ -63,7 +84,7 @@ impl std::error::Error for Error {
             Self::Obj(e) => Some(e),
             Self::File(e) => Some(e),
             Self::Build { source, .. } => Some(source),
-            Self::HitCountMismatch { .. } => None,
+            Self::RunsDiffer { .. } | Self::Usage(_) | Self::HitCountMismatch { .. } => None,
         }
     }
 }

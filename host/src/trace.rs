@@ -5,7 +5,7 @@ use crate::error::Error;
 use crate::obj::Mesh;
 use crate::rayfile::{HitRecord, RayRecord};
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
-use raykernel::{Accel, Bvh, Linear, Node, Ray, Scalar, I16F16};
+use raykernel::{Accel, Bvh, Linear, Node, Ray, Scalar, Triangle, I16F16};
 use std::path::Path;
 use std::time::Instant;
 
@@ -81,17 +81,26 @@ pub struct TraceConfig {
     pub mode: Mode,
     /// Trace rays `0, stride, 2·stride, ...` only. Must be at least 1.
     pub stride: usize,
+    /// Full runs (build + trace) to time; the figures are their medians. Must be at least 1.
+    pub runs: usize,
+    /// Build with [`Bvh::build_in_leaf_order`] (primitives permuted into leaf order; hits
+    /// still report original ids). Ignored by [`AccelKind::Linear`].
+    pub leaf_order: bool,
 }
 
-/// Figures of one trace run.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// Figures of a trace: times are the medians over the runs.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct TraceStats {
     /// Triangles in the scene.
     pub triangles: usize,
-    /// Wall time of `Bvh::build` (0 for linear).
+    /// Median wall time of the build, including the leaf-order permutation (0 for linear).
     pub build_ms: f64,
-    /// Wall time of preparing, tracing and storing every traced ray.
+    /// Median wall time of preparing, tracing and storing every traced ray.
     pub trace_ms: f64,
+    /// Build time of each run, in run order.
+    pub build_ms_runs: Vec<f64>,
+    /// Trace time of each run, in run order.
+    pub trace_ms_runs: Vec<f64>,
     /// Rays traced (after the stride).
     pub rays: usize,
     /// Rays that hit something.
@@ -115,15 +124,17 @@ pub struct TraceOutput {
     pub stats: TraceStats,
 }
 
-/// Builds the accelerator `config` asks for over `mesh` and traces every `stride`-th ray.
-/// Single-threaded. `scene` only labels errors.
+/// Builds the accelerator `config` asks for over `mesh` and traces every `stride`-th ray,
+/// `config.runs` times (build + trace each time, single-threaded), as WORKLOAD.md's protocol
+/// asks. Times are the medians over the runs; the hits are those of the last run, which must
+/// equal those of every other run. `scene` only labels errors.
 ///
 /// # Errors
 /// [`Error::Obj`] for a vertex the mode cannot represent, [`Error::Build`] if the kernel
-/// refuses to build.
+/// refuses to build, [`Error::RunsDiffer`] if two runs give different hits.
 ///
 /// # Panics
-/// If `config.stride` is 0.
+/// If `config.stride` or `config.runs` is 0.
 pub fn trace(
     mesh: &Mesh,
     scene: &Path,
@@ -142,35 +153,116 @@ fn trace_in<S: Scalar>(
     rays: &[RayRecord],
     config: &TraceConfig,
 ) -> Result<TraceOutput, Error> {
+    assert!(config.runs > 0, "runs must be at least 1");
     let tris = mesh.kernel_triangles::<S>(scene)?;
-    let n = tris.len();
-    let (hits, mut stats) = match config.accel {
-        AccelKind::Linear => trace_rays(&Linear::new(&tris), rays, config.stride),
+    let mut arena = match config.accel {
+        AccelKind::Bvh => NodeArena::<S>::new(nodes_needed(tris.len())),
+        AccelKind::Linear => NodeArena::<S>::new(0),
+    };
+    let mut first: Option<Vec<HitRecord>> = None;
+    let mut last = None;
+    let (mut build_ms_runs, mut trace_ms_runs) = (Vec::new(), Vec::new());
+    for run in 0..config.runs {
+        let (hits, stats) = run_once(&tris, &mut arena, scene, rays, config)?;
+        if let Some(first) = &first {
+            if let Some(ray) = first_difference(first, &hits) {
+                return Err(Error::RunsDiffer {
+                    scene: scene.to_path_buf(),
+                    run: run + 1,
+                    ray: ray * config.stride,
+                });
+            }
+        } else {
+            first = Some(hits.clone());
+        }
+        build_ms_runs.push(stats.build_ms);
+        trace_ms_runs.push(stats.trace_ms);
+        last = Some((hits, stats));
+    }
+    let (hits, stats) = last.unwrap_or_default();
+    let stats = TraceStats {
+        triangles: tris.len(),
+        build_ms: median(&build_ms_runs),
+        trace_ms: median(&trace_ms_runs),
+        build_ms_runs,
+        trace_ms_runs,
+        ..stats
+    };
+    Ok(TraceOutput { hits, stats })
+}
+
+/// One run: build (timed) and trace (timed).
+fn run_once<S: Scalar>(
+    tris: &[Triangle<S>],
+    arena: &mut NodeArena<S>,
+    scene: &Path,
+    rays: &[RayRecord],
+    config: &TraceConfig,
+) -> Result<(Vec<HitRecord>, TraceStats), Error> {
+    let build_error = |source| Error::Build {
+        scene: scene.to_path_buf(),
+        source,
+    };
+    match config.accel {
+        AccelKind::Linear => Ok(trace_rays(&Linear::new(tris), rays, config.stride)),
+        AccelKind::Bvh if config.leaf_order => {
+            // The permutation works in place: give it a fresh copy (untimed, like parsing).
+            let mut own = tris.to_vec();
+            let mut ids = vec![0u32; tris.len()];
+            let start = Instant::now();
+            let bvh = Bvh::build_in_leaf_order(&mut own, arena.slots(), &mut ids, config.build)
+                .map_err(build_error)?;
+            let build_ms = millis(start);
+            Ok(traced_bvh(&bvh, build_ms, rays, config.stride))
+        }
         AccelKind::Bvh => {
-            let mut arena = NodeArena::<S>::new(nodes_needed(n));
-            let mut ids = vec![0u32; n];
+            let mut ids = vec![0u32; tris.len()];
             let start = Instant::now();
             let bvh =
-                Bvh::build(&tris, arena.slots(), &mut ids, config.build).map_err(|source| {
-                    Error::Build {
-                        scene: scene.to_path_buf(),
-                        source,
-                    }
-                })?;
+                Bvh::build(tris, arena.slots(), &mut ids, config.build).map_err(build_error)?;
             let build_ms = millis(start);
-            let (hits, stats) = trace_rays(&bvh, rays, config.stride);
-            let stats = TraceStats {
-                build_ms,
-                nodes: bvh.nodes().len(),
-                accel_bytes: bvh.bytes_used(),
-                depth: bvh.depth(),
-                ..stats
-            };
-            (hits, stats)
+            Ok(traced_bvh(&bvh, build_ms, rays, config.stride))
         }
+    }
+}
+
+fn traced_bvh<S: Scalar>(
+    bvh: &Bvh<'_, S, Triangle<S>>,
+    build_ms: f64,
+    rays: &[RayRecord],
+    stride: usize,
+) -> (Vec<HitRecord>, TraceStats) {
+    let (hits, stats) = trace_rays(bvh, rays, stride);
+    let stats = TraceStats {
+        build_ms,
+        nodes: bvh.nodes().len(),
+        accel_bytes: bvh.bytes_used(),
+        depth: bvh.depth(),
+        ..stats
     };
-    stats.triangles = n;
-    Ok(TraceOutput { hits, stats })
+    (hits, stats)
+}
+
+/// Index of the first record that differs bit for bit (or the shorter length), if any.
+fn first_difference(a: &[HitRecord], b: &[HitRecord]) -> Option<usize> {
+    let same = |x: &HitRecord, y: &HitRecord| x.t.to_bits() == y.t.to_bits() && x.prim == y.prim;
+    a.iter()
+        .zip(b)
+        .position(|(x, y)| !same(x, y))
+        .or_else(|| (a.len() != b.len()).then(|| a.len().min(b.len())))
+}
+
+/// The median (mean of the middle two for an even count); 0 for none.
+#[must_use]
+pub fn median(xs: &[f64]) -> f64 {
+    let mut v = xs.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    match n {
+        0 => 0.0,
+        _ if n % 2 == 1 => v[n / 2],
+        _ => (v[n / 2 - 1] + v[n / 2]) / 2.0,
+    }
 }
 
 /// A node arena whose first slot sits on a 64-byte boundary, so that each sibling pair (two
@@ -236,4 +328,33 @@ fn trace_rays<S: Scalar, A: Accel<S>>(
 
 fn millis(start: Instant) -> f64 {
     start.elapsed().as_secs_f64() * 1e3
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_of_odd_even_and_empty_lists() {
+        assert_eq!(median(&[]), 0.0);
+        assert_eq!(median(&[4.0]), 4.0);
+        assert_eq!(median(&[9.0, 1.0, 5.0]), 5.0);
+        assert_eq!(median(&[9.0, 1.0, 5.0, 3.0]), 4.0);
+    }
+
+    #[test]
+    fn first_difference_is_bitwise() {
+        let h = |t: f32, prim| HitRecord { t, prim };
+        let a = [h(1.0, 1), h(0.0, 2), HitRecord::MISS];
+        assert_eq!(first_difference(&a, &a), None);
+        assert_eq!(
+            first_difference(&a, &[h(1.0, 1), h(-0.0, 2), HitRecord::MISS]),
+            Some(1)
+        );
+        assert_eq!(first_difference(&a, &a[..2]), Some(2));
+        assert_eq!(
+            first_difference(&a, &[h(1.0, 1), h(0.0, 3), HitRecord::MISS]),
+            Some(1)
+        );
+    }
 }

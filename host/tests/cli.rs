@@ -75,6 +75,8 @@ fn trace_prints_a_json_report_as_the_last_line() {
         "builder",
         "mode",
         "leaf",
+        "leaf_order",
+        "runs",
         "stride",
         "triangles",
         "build_ms",
@@ -94,6 +96,8 @@ fn trace_prints_a_json_report_as_the_last_line() {
     assert_eq!(v["mode"], "fixed");
     assert_eq!(v["triangles"], 80);
     assert_eq!(v["rays"], 50);
+    assert_eq!(v["runs"], 1);
+    assert_eq!(v["leaf_order"], false);
     assert_eq!(std::fs::metadata(&hits).unwrap().len(), 50 * 8);
 
     let same = host(&[&p("compare-hits"), &hits, &hits]);
@@ -185,6 +189,11 @@ fn bad_arguments_are_usage_errors() {
         (vec!["--stride", "0"], "--stride"),
         (vec!["--stride=-3"], "--stride"),
         (vec!["--bogus"], "unexpected argument '--bogus'"),
+        (vec!["--runs", "0"], "--runs"),
+        (
+            vec!["--leaf-order", "--accel", "linear"],
+            "--leaf-order needs --accel bvh",
+        ),
     ] {
         let extra: Vec<PathBuf> = extra.into_iter().map(p).collect();
         let args: Vec<&Path> = base

@@ -97,6 +97,8 @@ fn args(s: &Scene, accel: AccelKind, builder: Builder, mode: Mode, leaf: u32) ->
         mode,
         leaf,
         stride: 1,
+        runs: 1,
+        leaf_order: false,
     }
 }
 
@@ -191,4 +193,62 @@ fn stride_traces_every_kth_ray_and_matches_the_full_run() {
             assert_eq!(report.stride, stride);
         }
     }
+}
+
+#[test]
+fn leaf_order_writes_the_same_hit_files() {
+    let s = scene("end_to_end_leaf_order");
+    for mode in [Mode::F32, Mode::Fixed] {
+        for builder in [Builder::Sah, Builder::Median, Builder::Midpoint] {
+            for leaf in [1, 4, 16] {
+                let normal = args(&s, AccelKind::Bvh, builder, mode, leaf);
+                let (normal_report, normal_bytes) = run(&normal);
+                let mut a = normal.clone();
+                a.leaf_order = true;
+                a.out = s
+                    .dir
+                    .join(format!("leaf_order.{builder:?}.{mode:?}.{leaf}.hits"));
+                let (report, bytes) = run(&a);
+                assert!(
+                    bytes == normal_bytes,
+                    "{mode:?} {builder:?} leaf {leaf}: leaf-order hits differ"
+                );
+                assert!(report.leaf_order && !normal_report.leaf_order);
+                // Same tree, only the primitives moved.
+                assert_eq!(
+                    (report.nodes, report.depth, report.hits),
+                    (normal_report.nodes, normal_report.depth, normal_report.hits)
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn several_runs_report_medians_and_write_the_same_hits() {
+    let s = scene("end_to_end_runs");
+    for leaf_order in [false, true] {
+        let mut one = args(&s, AccelKind::Bvh, Builder::Sah, Mode::Fixed, 4);
+        one.leaf_order = leaf_order;
+        let (_, once) = run(&one);
+        let mut three = one.clone();
+        three.runs = 3;
+        three.out = s.dir.join(format!("runs3.{leaf_order}.hits"));
+        let (report, bytes) = run(&three);
+        assert!(bytes == once, "leaf_order {leaf_order}");
+        assert_eq!(report.runs, 3);
+        assert_eq!(report.build_ms_runs.len(), 3);
+        assert_eq!(report.trace_ms_runs.len(), 3);
+        assert_eq!(report.trace_ms, host::trace::median(&report.trace_ms_runs));
+        assert_eq!(report.build_ms, host::trace::median(&report.build_ms_runs));
+        let want = report.rays as f64 / (report.trace_ms / 1e3) / 1e6;
+        assert!(
+            (report.mrays_per_s - want).abs() <= 1e-9 * want,
+            "{report:?}"
+        );
+    }
+    let mut linear = args(&s, AccelKind::Linear, Builder::Sah, Mode::F32, 4);
+    linear.runs = 2;
+    let (report, _) = run(&linear);
+    assert_eq!((report.runs, report.build_ms), (2, 0.0));
 }

@@ -43,6 +43,8 @@ fn bunny_bvh_matches_brute_force_for_every_builder_and_mode() {
             },
             mode,
             stride: 1,
+            runs: 1,
+            leaf_order: false,
         };
         let linear = trace(
             &mesh,
