@@ -2,6 +2,7 @@
 //!
 //! Each command returns the JSON object `main` prints as the last line of stdout.
 
+use crate::classify::{classify, Classification};
 use crate::compare::{compare_hits, Comparison, DEFAULT_REL};
 use crate::error::Error;
 use crate::obj::load_obj;
@@ -27,7 +28,9 @@ pub struct Cli {
 pub enum Command {
     /// Trace a ray file against an OBJ scene and write the closest hits.
     Trace(TraceArgs),
-    /// Compare two hit files ray by ray (same rule as shared/bench/compare_hits.py).
+    /// Compare two hit files ray by ray (same rule as shared/bench/compare_hits.py); with
+    /// --scene and --rays, also check each differing ray passes within quantization error of an
+    /// edge of a reported triangle.
     CompareHits(CompareArgs),
 }
 
@@ -67,7 +70,7 @@ pub struct TraceArgs {
     pub leaf_order: bool,
 }
 
-/// `host compare-hits REF OTHER [--rel R]`.
+/// `host compare-hits REF OTHER [--rel R] [--scene OBJ --rays RAYS]`.
 #[derive(Clone, Debug, Args)]
 pub struct CompareArgs {
     /// The reference hit file.
@@ -77,6 +80,24 @@ pub struct CompareArgs {
     /// Relative tolerance on t.
     #[arg(long, default_value_t = DEFAULT_REL)]
     pub rel: f64,
+    /// The scene both hit files were traced against: classify the rays whose prim differs.
+    #[arg(long, requires = "rays")]
+    pub scene: Option<PathBuf>,
+    /// The ray file both hit files were traced from (whole file, stride 1).
+    #[arg(long, requires = "scene")]
+    pub rays: Option<PathBuf>,
+}
+
+/// The JSON report of `host compare-hits`: the agreement figures, plus the classification of the
+/// differing rays when `--scene` and `--rays` are given.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CompareReport {
+    /// Agreement figures.
+    #[serde(flatten)]
+    pub comparison: Comparison,
+    /// Classification of the rays whose prim ids differ.
+    #[serde(flatten)]
+    pub classification: Option<Classification>,
 }
 
 /// The JSON report of `host trace`.
@@ -208,8 +229,9 @@ pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
 /// `host compare-hits`: agreement of OTHER with REF.
 ///
 /// # Errors
-/// Unreadable or malformed hit files, or files of different lengths.
-pub fn run_compare(args: &CompareArgs) -> Result<Comparison, Error> {
+/// Unreadable or malformed hit files, or files of different lengths; with `--scene` and
+/// `--rays`, also a bad scene or ray file, or hits that do not fit them.
+pub fn run_compare(args: &CompareArgs) -> Result<CompareReport, Error> {
     let reference = read_hits(&args.reference)?;
     let other = read_hits(&args.other)?;
     if reference.len() != other.len() {
@@ -219,5 +241,23 @@ pub fn run_compare(args: &CompareArgs) -> Result<Comparison, Error> {
             other: entry(&args.other, other.len()),
         });
     }
-    Ok(compare_hits(&reference, &other, args.rel))
+    let comparison = compare_hits(&reference, &other, args.rel);
+    let classification = match (&args.scene, &args.rays) {
+        (Some(scene), Some(rays_path)) => {
+            let mesh = load_obj(scene)?;
+            let rays = read_rays(rays_path)?;
+            let c =
+                classify(&reference, &other, &rays, &mesh).map_err(|source| Error::Classify {
+                    scene: scene.clone(),
+                    rays: rays_path.clone(),
+                    source,
+                })?;
+            Some(c)
+        }
+        _ => None,
+    };
+    Ok(CompareReport {
+        comparison,
+        classification,
+    })
 }

@@ -1,5 +1,6 @@
 //! The host's error type: one variant per source, each printing one self-contained line.
 
+use crate::classify::ClassifyError;
 use crate::obj::ObjError;
 use crate::rayfile::FileError;
 use raykernel::BuildError;
@@ -28,6 +29,15 @@ pub enum Error {
         run: usize,
         /// The first ray (index in the ray file) whose hit differs.
         ray: usize,
+    },
+    /// `compare-hits --scene --rays`: the hits do not fit the scene or the ray file.
+    Classify {
+        /// The scene.
+        scene: PathBuf,
+        /// The ray file.
+        rays: PathBuf,
+        /// What does not fit.
+        source: ClassifyError,
     },
     /// Arguments that parse but do not go together (exit code 2, like clap's).
     Usage(String),
@@ -65,6 +75,16 @@ impl fmt::Display for Error {
                 "{}: run {run} gave different hits from run 1 (first at ray {ray})",
                 scene.display()
             ),
+            Self::Classify {
+                scene,
+                rays,
+                source,
+            } => write!(
+                f,
+                "cannot classify the differences against {} and {}: {source}",
+                scene.display(),
+                rays.display()
+            ),
             Self::Usage(msg) => f.write_str(msg),
             Self::HitCountMismatch { reference, other } => write!(
                 f,
@@ -84,6 +104,7 @@ impl std::error::Error for Error {
             Self::Obj(e) => Some(e),
             Self::File(e) => Some(e),
             Self::Build { source, .. } => Some(source),
+            Self::Classify { source, .. } => Some(source),
             Self::RunsDiffer { .. } | Self::Usage(_) | Self::HitCountMismatch { .. } => None,
         }
     }

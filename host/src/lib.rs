@@ -5,10 +5,13 @@
 //! - [`rayfile`]: ray and hit file records,
 //! - [`trace`]: build an accelerator and trace rays, generic over the kernel's scalar modes,
 //! - [`compare`]: agreement between two hit files,
+//! - [`classify`]: whether rays on which two hit files differ pass within quantization error of
+//!   an edge,
 //! - [`cli`]: the command line (clap) and the commands behind it,
 //! - [`error`]: the error type `main` turns into a message and an exit code.
 #![forbid(unsafe_code)]
 
+pub mod classify;
 pub mod cli;
 pub mod compare;
 pub mod error;

@@ -226,3 +226,119 @@ fn compare_hits_rejects_files_of_different_lengths() {
         "not a multiple of 8",
     );
 }
+
+/// Runs `host` and parses its last stdout line as JSON; panics (with stderr) on failure.
+fn host_json(args: &[&Path]) -> serde_json::Value {
+    let out = host(args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    serde_json::from_str(stdout.lines().last().unwrap()).unwrap()
+}
+
+#[test]
+fn compare_hits_classifies_fixed_vs_f32_differences() {
+    let dir = temp_dir("cli_classify");
+    let obj = dir.join("s.obj");
+    std::fs::write(&obj, icosphere([0.1, 0.2, -0.3], 1.5, 3).to_obj()).unwrap();
+    let rays = dir.join("s.rays");
+    let mut rng = Rng::new(11);
+    write_rays(&rays, &random_rays(&mut rng, [-2.5; 3], [2.5; 3], 3000)).unwrap();
+    let (f, x) = (dir.join("f32.hits"), dir.join("fixed.hits"));
+    for (mode, hits) in [("f32", &f), ("fixed", &x)] {
+        host_json(&[
+            &p("trace"),
+            &obj,
+            &rays,
+            &p("--out"),
+            hits,
+            &p("--mode"),
+            &p(mode),
+        ]);
+    }
+    let v = host_json(&[
+        &p("compare-hits"),
+        &f,
+        &x,
+        &p("--scene"),
+        &obj,
+        &p("--rays"),
+        &rays,
+    ]);
+    assert_eq!(v["n"], 3000);
+    assert_eq!(v["bound"], "4*sqrt(3)*2^-17 + t*2^-28");
+    let count = |k: &str| v[k].as_u64().unwrap_or_else(|| panic!("{k} in {v}"));
+    assert_eq!(
+        count("differing"),
+        count("explained_by_quantization") + count("explained_by_depth") + count("unexplained"),
+        "{v}"
+    );
+    assert_eq!(count("unexplained"), 0, "{v}");
+    assert!(
+        v["max_edge_distance_of_differing"].as_f64().unwrap() <= 1e-4,
+        "{v}"
+    );
+
+    // Without --scene/--rays: no classification fields.
+    let plain = host_json(&[&p("compare-hits"), &f, &x]);
+    assert!(plain.get("differing").is_none(), "{plain}");
+
+    // --scene and --rays go together.
+    assert_fails(
+        &host(&[&p("compare-hits"), &f, &x, &p("--scene"), &obj]),
+        2,
+        "--rays",
+    );
+    assert_fails(
+        &host(&[&p("compare-hits"), &f, &x, &p("--rays"), &rays]),
+        2,
+        "--scene",
+    );
+    // A ray file that does not go with the hits.
+    let short = dir.join("short.rays");
+    write_rays(&short, &random_rays(&mut rng, [-2.5; 3], [2.5; 3], 10)).unwrap();
+    let args = [
+        &p("compare-hits"),
+        &f,
+        &x,
+        &p("--scene"),
+        &obj,
+        &p("--rays"),
+    ];
+    let mut with_short: Vec<&Path> = args.iter().map(|a| a.as_path()).collect();
+    with_short.push(&short);
+    assert_fails(
+        &host(&with_short),
+        1,
+        "the hit files have 3000 records but the ray file has 10 rays",
+    );
+    // Hits naming a triangle the scene does not have.
+    let bogus = dir.join("bogus.hits");
+    write_hits(
+        &bogus,
+        &vec![
+            HitRecord {
+                t: 1.0,
+                prim: 99_999
+            };
+            3000
+        ],
+    )
+    .unwrap();
+    assert_fails(
+        &host(&[
+            &p("compare-hits"),
+            &f,
+            &bogus,
+            &p("--scene"),
+            &obj,
+            &p("--rays"),
+            &rays,
+        ]),
+        1,
+        "hits triangle 99999, but the scene has 1280 triangles",
+    );
+}
