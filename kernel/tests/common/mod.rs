@@ -1,0 +1,269 @@
+//! Helpers shared by the kernel's host-run test suites (each suite uses a subset).
+#![allow(dead_code)]
+
+use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
+use raykernel::{
+    Accel, Bvh, Hit, Node, PointError, Primitive, Ray, Scalar, F32_COORD_LIMIT, FIXED_COORD_LIMIT,
+    I16F16,
+};
+use std::fmt;
+use std::ops::{Add, Mul, Sub};
+
+/// Leaf sizes every differential test builds with.
+pub const LEAF_SIZES: [u32; 4] = [1, 2, 4, 8];
+
+/// What the suites need from a number mode beyond [`Scalar`]: exact bits, arithmetic for
+/// computing targets in the mode itself, tolerances and per-mode bad inputs.
+pub trait TestScalar:
+    Scalar + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self>
+{
+    /// The exact bits (`f32::to_bits`, so `-0` and `+0` differ; raw `i32` for fixed point).
+    fn bits(self) -> u32;
+    /// Absolute tolerance for comparing a result of this mode with an `f64` reference of
+    /// magnitude `exact` (the reference is computed from the same, already rounded, inputs).
+    fn tol(exact: f64) -> f64;
+    /// Values every vertex/origin check must reject, with the error expected for them.
+    fn bad_coords() -> Vec<(Self, PointError)>;
+    /// Half of `self`, rounded as the mode rounds.
+    fn half(self) -> Self;
+}
+
+impl TestScalar for f32 {
+    fn bits(self) -> u32 {
+        self.to_bits()
+    }
+    fn tol(exact: f64) -> f64 {
+        1e-5 * exact.abs().max(1.0)
+    }
+    fn bad_coords() -> Vec<(Self, PointError)> {
+        let out = PointError::OutOfRange {
+            limit: F32_COORD_LIMIT,
+        };
+        vec![
+            (f32::NAN, PointError::NonFinite),
+            (-f32::NAN, PointError::NonFinite),
+            (f32::INFINITY, PointError::NonFinite),
+            (f32::NEG_INFINITY, PointError::NonFinite),
+            (next_up(F32_COORD_LIMIT), out),
+            (-next_up(F32_COORD_LIMIT), out),
+            (f32::MAX, out),
+        ]
+    }
+    fn half(self) -> Self {
+        self * 0.5
+    }
+}
+
+impl TestScalar for I16F16 {
+    fn bits(self) -> u32 {
+        self.raw() as u32
+    }
+    fn tol(exact: f64) -> f64 {
+        // Q16.16 coordinates and distances (resolution 2^-16), Q2.30 directions; the slab test
+        // pads by 2 raw units plus one raw unit of origin shift divided by a direction component.
+        16.0 / 65536.0 + 1e-5 * exact.abs()
+    }
+    fn bad_coords() -> Vec<(Self, PointError)> {
+        let out = PointError::OutOfRange {
+            limit: FIXED_COORD_LIMIT,
+        };
+        vec![
+            (I16F16::from_raw((1 << 29) + 1), out),
+            (I16F16::from_raw(-(1 << 29) - 1), out),
+            (I16F16::MAX, out),
+            (I16F16::MIN, out),
+        ]
+    }
+    fn half(self) -> Self {
+        // Floor; exact for even raw values.
+        I16F16::from_raw(self.raw() >> 1)
+    }
+}
+
+/// The next `f32` above a positive finite `x`.
+pub fn next_up(x: f32) -> f32 {
+    f32::from_bits(x.to_bits() + 1)
+}
+
+/// A mode value from an `f32` constant that must be representable in range.
+pub fn c<S: Scalar>(x: f32) -> S {
+    S::coord_from_f32(x).unwrap_or_else(|e| panic!("{} constant {x}: {e}", S::NAME))
+}
+
+/// A mode point from `f32` constants.
+pub fn p<S: Scalar>(x: [f32; 3]) -> [S; 3] {
+    x.map(c::<S>)
+}
+
+/// The exact bits of a hit (t, prim, u, v).
+pub fn hit_bits<S: TestScalar>(h: &Option<Hit<S>>) -> Option<(u32, u32, u32, u32)> {
+    h.map(|h| (h.t.bits(), h.prim, h.u.bits(), h.v.bits()))
+}
+
+/// Compares two closest hits bit for bit; the error names both hits.
+pub fn same_hit<S: TestScalar>(got: &Option<Hit<S>>, want: &Option<Hit<S>>) -> Result<(), String> {
+    if hit_bits(got) == hit_bits(want) {
+        Ok(())
+    } else {
+        Err(format!(
+            "hits differ: got {got:?} (bits {:x?}), want {want:?} (bits {:x?})",
+            hit_bits(got),
+            hit_bits(want)
+        ))
+    }
+}
+
+/// A ray as given to [`Ray::from_f32`]; printed with values and bits so a failure can be
+/// replayed exactly.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RaySpec {
+    pub o: [f32; 3],
+    pub d: [f32; 3],
+    pub t_min: f32,
+    pub t_max: f32,
+}
+
+impl RaySpec {
+    pub fn new(o: [f32; 3], d: [f32; 3]) -> Self {
+        Self {
+            o,
+            d,
+            t_min: 0.0,
+            t_max: f32::INFINITY,
+        }
+    }
+    pub fn interval(self, t_min: f32, t_max: f32) -> Self {
+        Self {
+            t_min,
+            t_max,
+            ..self
+        }
+    }
+    /// The ray in mode `S`; panics (naming the ray) if the kernel rejects it.
+    pub fn ray<S: Scalar>(&self) -> Ray<S> {
+        Ray::from_f32(self.o, self.d, self.t_min, self.t_max)
+            .unwrap_or_else(|e| panic!("{} ray {self}: {e:?}", S::NAME))
+    }
+}
+
+impl fmt::Display for RaySpec {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let b = |v: [f32; 3]| v.map(f32::to_bits);
+        write!(
+            f,
+            "origin {:?} (bits {:#010x?}) dir {:?} (bits {:#010x?}) t [{}, {}]",
+            self.o,
+            b(self.o),
+            self.d,
+            b(self.d),
+            self.t_min,
+            self.t_max
+        )
+    }
+}
+
+/// `b - a` in `f32`, and `+z` if that is the zero vector.
+pub fn dir_to(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    if d == [0.0; 3] {
+        [0.0, 0.0, 1.0]
+    } else {
+        d
+    }
+}
+
+/// Builds a BVH into freshly allocated arenas of exactly the documented size and hands it to `f`.
+pub fn with_bvh<S, P, R>(
+    prims: &[P],
+    options: BuildOptions,
+    f: impl FnOnce(&Bvh<'_, S, P>) -> R,
+) -> R
+where
+    S: Scalar,
+    P: Primitive<S>,
+{
+    let mut nodes = vec![Node::<S>::EMPTY; nodes_needed(prims.len())];
+    let mut ids = vec![0u32; prims.len()];
+    let bvh = Bvh::build(prims, &mut nodes, &mut ids, options).unwrap_or_else(|e| {
+        panic!(
+            "{} build ({} prims, {options:?}) failed: {e}",
+            S::NAME,
+            prims.len()
+        )
+    });
+    f(&bvh)
+}
+
+/// Every (builder, leaf size) combination the differential tests cover.
+pub fn all_options() -> impl Iterator<Item = BuildOptions> {
+    BuilderKind::ALL.into_iter().flat_map(|builder| {
+        LEAF_SIZES
+            .into_iter()
+            .map(move |max_leaf_size| BuildOptions {
+                builder,
+                max_leaf_size,
+            })
+    })
+}
+
+/// Closest hit of `accel`, plus a check that its any-hit query agrees.
+pub fn query<S: TestScalar, A: Accel<S>>(
+    accel: &A,
+    ray: &Ray<S>,
+) -> Result<Option<Hit<S>>, String> {
+    let hit = accel.intersect(ray);
+    let occluded = accel.occluded(ray);
+    if occluded != hit.is_some() {
+        return Err(format!("occluded() = {occluded} but intersect() = {hit:?}"));
+    }
+    Ok(hit)
+}
+
+/// SplitMix64: a tiny seeded generator, identical on every platform.
+#[derive(Clone, Debug)]
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Self(seed)
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    /// Uniform in `[0, 1)` with 24 random bits.
+    pub fn unit(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+    /// Uniform in `[lo, hi)`.
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.unit()
+    }
+    /// Uniform in `0..n`.
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next_u64() % n as u64) as usize
+    }
+    /// A uniformly distributed unit vector (rejection sampling in `f64`).
+    pub fn unit_vec(&mut self) -> [f32; 3] {
+        loop {
+            let v = [0; 3].map(|_| self.range(-1.0, 1.0) as f64);
+            let l2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+            if l2 > 1e-4 && l2 <= 1.0 {
+                let l = l2.sqrt();
+                return v.map(|x| (x / l) as f32);
+            }
+        }
+    }
+    /// A point uniformly distributed in the ball of radius `r` around the origin.
+    pub fn in_ball(&mut self, r: f32) -> [f32; 3] {
+        loop {
+            let v = [0; 3].map(|_| self.range(-r, r));
+            if v[0] * v[0] + v[1] * v[1] + v[2] * v[2] <= r * r {
+                return v;
+            }
+        }
+    }
+}
