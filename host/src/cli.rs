@@ -7,6 +7,8 @@ use crate::compare::{compare_hits, Comparison, DEFAULT_REL};
 use crate::error::Error;
 use crate::obj::load_obj;
 use crate::rayfile::{read_hits, read_rays, write_hits};
+use crate::render::{render, write_png, RenderConfig};
+use crate::scene::{CameraSource, Scene};
 use crate::trace::{trace, AccelKind, Builder, Mode, TraceConfig};
 use clap::builder::RangedU64ValueParser;
 use clap::{Args, Parser, Subcommand};
@@ -32,6 +34,105 @@ pub enum Command {
     /// --scene and --rays, also check each differing ray passes within quantization error of an
     /// edge of a reported triangle.
     CompareHits(CompareArgs),
+    /// Render a scene to a PNG: the built-in one, or an OBJ (camera from NAME.camera beside
+    /// it, or framed); one primary ray per pixel, Lambert shading, hard shadows.
+    Render(RenderArgs),
+}
+
+/// `host render [SCENE.obj] --out FILE.png [options]`.
+#[derive(Clone, Debug, Args)]
+pub struct RenderArgs {
+    /// An OBJ scene; without it, the built-in scene (generated, needs no files).
+    pub scene: Option<PathBuf>,
+    /// The PNG to write.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 640,
+          value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 480,
+          value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub height: u32,
+    /// Number mode of the kernel.
+    #[arg(long, value_enum, default_value_t = Mode::F32)]
+    pub mode: Mode,
+    /// Worker threads [default: the available parallelism].
+    #[arg(long, value_parser = RangedU64ValueParser::<usize>::new().range(1..=1024))]
+    pub threads: Option<usize>,
+    /// BVH builder.
+    #[arg(long, value_enum, default_value_t = Builder::Sah)]
+    pub builder: Builder,
+    /// Largest BVH leaf (1..=64).
+    #[arg(long, default_value_t = 4,
+          value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_LEAF_SIZE)))]
+    pub leaf: u32,
+}
+
+/// The JSON report of `host render`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RenderReport {
+    /// `built-in` or the OBJ path.
+    pub scene: String,
+    /// `built-in`, `framed`, or the `.camera` file.
+    pub camera: String,
+    /// PNG path.
+    pub out: String,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `f32` or `fixed`.
+    pub mode: &'static str,
+    /// BVH builder.
+    pub builder: &'static str,
+    /// Largest leaf.
+    pub leaf: u32,
+    /// Threads used.
+    pub threads: usize,
+    /// Triangles.
+    pub triangles: usize,
+    /// BVH build time.
+    pub build_ms: f64,
+    /// Render time (all pixels, all threads; no PNG encoding).
+    pub render_ms: f64,
+    /// Primary rays.
+    pub primary_rays: u64,
+    /// Shadow rays.
+    pub shadow_rays: u64,
+    /// Primary and shadow rays.
+    pub rays: u64,
+    /// Million rays per second of render time.
+    pub mrays_per_s: f64,
+    /// Primary rays that hit.
+    pub hits: u64,
+}
+
+impl RenderReport {
+    /// One line for people: size, time, rays, Mrays/s.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        format!(
+            "rendered {} ({} triangles) at {}x{}, {}, {} BVH, {} thread{}: build {:.1} ms, \
+             render {:.1} ms, {} rays ({} primary + {} shadow), {:.2} Mrays/s -> {}",
+            self.scene,
+            self.triangles,
+            self.width,
+            self.height,
+            self.mode,
+            self.builder,
+            self.threads,
+            if self.threads == 1 { "" } else { "s" },
+            self.build_ms,
+            self.render_ms,
+            self.rays,
+            self.primary_rays,
+            self.shadow_rays,
+            self.mrays_per_s,
+            self.out
+        )
+    }
 }
 
 /// `host trace SCENE.obj RAYS --out HITS [options]`.
@@ -151,17 +252,76 @@ pub struct TraceReport {
     pub depth: u32,
 }
 
-/// Runs a parsed command line; returns the one-line JSON object to print.
+/// Runs a parsed command line; returns what to print: the command's one-line JSON report as
+/// the last line (`render` puts a summary line for people before it).
 ///
 /// # Errors
 /// Whatever the command fails with.
 pub fn run(cli: &Cli) -> Result<String, Error> {
-    let json = match &cli.command {
-        Command::Trace(args) => serde_json::to_string(&run_trace(args)?),
-        Command::CompareHits(args) => serde_json::to_string(&run_compare(args)?),
+    let (summary, json) = match &cli.command {
+        Command::Trace(args) => (None, serde_json::to_string(&run_trace(args)?)),
+        Command::CompareHits(args) => (None, serde_json::to_string(&run_compare(args)?)),
+        Command::Render(args) => {
+            let report = run_render(args)?;
+            (Some(report.summary()), serde_json::to_string(&report))
+        }
     };
     // Structs of numbers and strings always serialize; the fallback only avoids a panic path.
-    Ok(json.unwrap_or_else(|e| format!("{{\"error\":\"cannot encode report: {e}\"}}")))
+    let json = json.unwrap_or_else(|e| format!("{{\"error\":\"cannot encode report: {e}\"}}"));
+    Ok(match summary {
+        Some(line) => format!("{line}\n{json}"),
+        None => json,
+    })
+}
+
+/// `host render`: load or generate the scene, render, write the PNG.
+///
+/// # Errors
+/// A bad or unreadable OBJ or `.camera` file, a scene the mode cannot represent, a build the
+/// kernel refuses, or an unwritable output.
+pub fn run_render(args: &RenderArgs) -> Result<RenderReport, Error> {
+    let scene = match &args.scene {
+        Some(path) => Scene::load(path, args.width, args.height)?,
+        None => Scene::built_in(),
+    };
+    let threads = args.threads.unwrap_or_else(|| {
+        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+    });
+    let config = RenderConfig {
+        width: args.width,
+        height: args.height,
+        mode: args.mode,
+        threads,
+        build: BuildOptions {
+            builder: args.builder.into(),
+            max_leaf_size: args.leaf,
+        },
+    };
+    let (image, stats) = render(&scene, &config)?;
+    write_png(&args.out, &image)?;
+    Ok(RenderReport {
+        scene: scene.name.clone(),
+        camera: match &scene.camera_source {
+            CameraSource::BuiltIn => "built-in".into(),
+            CameraSource::Framed => "framed".into(),
+            CameraSource::File(p) => p.display().to_string(),
+        },
+        out: args.out.display().to_string(),
+        width: args.width,
+        height: args.height,
+        mode: args.mode.name(),
+        builder: BuilderKind::from(args.builder).name(),
+        leaf: args.leaf,
+        threads: stats.threads,
+        triangles: stats.triangles,
+        build_ms: stats.build_ms,
+        render_ms: stats.render_ms,
+        primary_rays: stats.primary_rays,
+        shadow_rays: stats.shadow_rays,
+        rays: stats.rays(),
+        mrays_per_s: stats.mrays_per_s(),
+        hits: stats.hits,
+    })
 }
 
 /// `host trace`: load the scene and rays, trace, write the hits.

@@ -39,6 +39,15 @@ pub enum Error {
         /// What does not fit.
         source: ClassifyError,
     },
+    /// A bad or unreadable `.camera` file.
+    Camera {
+        /// The file.
+        path: PathBuf,
+        /// The line (1-based), if the problem is on one.
+        line: Option<usize>,
+        /// What is wrong.
+        msg: String,
+    },
     /// Arguments that parse but do not go together (exit code 2, like clap's).
     Usage(String),
     /// Two hit files to compare hold different numbers of records.
@@ -85,6 +94,10 @@ impl fmt::Display for Error {
                 scene.display(),
                 rays.display()
             ),
+            Self::Camera { path, line, msg } => match line {
+                Some(line) => write!(f, "{}:{line}: {msg}", path.display()),
+                None => write!(f, "{}: {msg}", path.display()),
+            },
             Self::Usage(msg) => f.write_str(msg),
             Self::HitCountMismatch { reference, other } => write!(
                 f,
@@ -105,7 +118,10 @@ impl std::error::Error for Error {
             Self::File(e) => Some(e),
             Self::Build { source, .. } => Some(source),
             Self::Classify { source, .. } => Some(source),
-            Self::RunsDiffer { .. } | Self::Usage(_) | Self::HitCountMismatch { .. } => None,
+            Self::RunsDiffer { .. }
+            | Self::Camera { .. }
+            | Self::Usage(_)
+            | Self::HitCountMismatch { .. } => None,
         }
     }
 }

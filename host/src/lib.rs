@@ -7,6 +7,7 @@
 //! - [`compare`]: agreement between two hit files,
 //! - [`classify`]: whether rays on which two hit files differ pass within quantization error of
 //!   an edge,
+//! - [`scene`], [`render`]: the built-in scene, cameras, and a primary-ray renderer (PNG out),
 //! - [`cli`]: the command line (clap) and the commands behind it,
 //! - [`error`]: the error type `main` turns into a message and an exit code.
 #![forbid(unsafe_code)]
@@ -17,6 +18,8 @@ pub mod compare;
 pub mod error;
 pub mod obj;
 pub mod rayfile;
+pub mod render;
+pub mod scene;
 pub mod trace;
 
 pub use error::Error;

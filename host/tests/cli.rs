@@ -205,7 +205,7 @@ fn bad_arguments_are_usage_errors() {
     }
     // --out is required.
     assert_fails(&host(&[&p("trace"), &obj, &rays]), 2, "--out");
-    assert_fails(&host(&[&p("render")]), 2, "unrecognized subcommand");
+    assert_fails(&host(&[&p("draw")]), 2, "unrecognized subcommand");
 }
 
 #[test]
