@@ -21,8 +21,8 @@ use raykernel::{Accel, Linear, Primitive, Sphere, Triangle, I16F16};
 
 const SEED: u64 = 0x5eed_7a11_0001;
 /// Cases per property (each case: 2 modes × 3 builders × 4 leaf sizes × RAYS_PER_CASE rays).
-const TRIANGLE_CASES: u32 = 3000;
-const SPHERE_CASES: u32 = 1000;
+const TRIANGLE_CASES: u32 = 1500;
+const SPHERE_CASES: u32 = 500;
 const RAYS_PER_CASE: usize = 32;
 
 fn seed() -> u64 {

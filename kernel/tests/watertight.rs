@@ -306,13 +306,13 @@ fn closed_mesh_cases<S: TestScalar>(name: &str, mesh: &Mesh, center: [f32; 3], i
     assert!(mesh.is_closed(), "{name} is not closed");
     let mut rng = Rng::new(SEED);
     let mut origins = vec![center];
-    for _ in 0..6 {
+    for _ in 0..4 {
         let q = rng.in_ball(inner);
         origins.push([0, 1, 2].map(|i| center[i] + q[i]));
     }
     let mut rays = Vec::new();
     for &origin in &origins {
-        rays.extend(rays_from::<S>(mesh, origin, 3, 1000, &mut rng));
+        rays.extend(rays_from::<S>(mesh, origin, 2, 500, &mut rng));
     }
     let name = format!("{name}, {} origins", origins.len());
     let (leaks, lines) = leak_report(&name, &mesh.triangles::<S>(), &rays, &builders_leaf4(), 1);
@@ -348,8 +348,9 @@ fn jittered_uv_sphere_cases<S: TestScalar>() {
     closed_mesh_cases::<S>("jittered UV sphere 24x48 r30±10%", &mesh, [0.0; 3], 15.0);
 }
 
-/// A finer icosphere (level 4, 5120 triangles) through the BVH only, every builder and leaf
-/// size; vertices and edge midpoints from the centre and one interior point.
+/// A finer, slightly jittered icosphere (level 4, 5120 triangles) through the BVH only, every
+/// builder and leaf size: vertices, edge midpoints, one random point per edge and random
+/// directions, from the centre and one interior point.
 fn fine_icosphere_cases<S: TestScalar>() {
     let mesh = icosphere(4, 60.0, 0.05, &mut Rng::new(SEED ^ 3));
     assert!(mesh.is_closed());
@@ -357,7 +358,7 @@ fn fine_icosphere_cases<S: TestScalar>() {
     let mut rng = Rng::new(SEED ^ 4);
     let mut rays = Vec::new();
     for origin in [[0.0; 3], [7.25, -11.5, 3.0]] {
-        rays.extend(rays_from::<S>(&mesh, origin, 1, 1000, &mut rng));
+        rays.extend(rays_from::<S>(&mesh, origin, 1, 500, &mut rng));
     }
     let options: Vec<_> = all_options().collect();
     let (leaks, lines) = leak_report("icosphere L4, 2 origins", &tris, &rays, &options, 0);

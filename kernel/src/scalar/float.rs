@@ -185,6 +185,22 @@ impl FloatRay {
         })
     }
 
+    /// Distance and barycentrics (of the second and third vertex) from the sheared vertices,
+    /// with the edge functions evaluated in `f64` (exact products, one rounding each).
+    /// `None` if the determinant is zero there. NaN (only from overflow) fails callers' range
+    /// tests.
+    #[inline]
+    fn solve(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> Option<(f32, f32, f32)> {
+        let e = |p: &[f32; 3], q: &[f32; 3]| p[0] as f64 * q[1] as f64 - p[1] as f64 * q[0] as f64;
+        let (u, v, w) = (e(c, b), e(a, c), e(b, a));
+        let det = u + v + w;
+        if det == 0.0 {
+            return None;
+        }
+        let t = (u * a[2] as f64 + v * b[2] as f64 + w * c[2] as f64) / det;
+        Some((t as f32, (v / det) as f32, (w / det) as f32))
+    }
+
     /// The three edge functions (U, V, W) of the sheared triangle, with the exact `f64`
     /// recomputation when any is zero (f32 products are exact in f64, so the sign is exact).
     #[inline(always)]
@@ -322,12 +338,13 @@ impl Scalar for f32 {
         if (eu < 0.0 || ev < 0.0 || ew < 0.0) && (eu > 0.0 || ev > 0.0 || ew > 0.0) {
             return None;
         }
-        let det = eu + ev + ew;
-        if det == 0.0 {
+        if eu + ev + ew == 0.0 {
             return None; // degenerate triangle, or a ray in its plane
         }
-        // Scaled hit distance. NaN (only from overflow) fails the range test.
-        let t = (eu * a[2] + ev * b[2] + ew * c[2]) / det;
+        // The signs above decide hit or miss (watertight). For the distance, recompute the
+        // edge functions in f64, where the f32 products are exact: on slivers the f32 values
+        // keep too few bits for an accurate t. Rare path: candidates only.
+        let (t, _, _) = FloatRay::solve(&a, &b, &c)?;
         if !(t >= t_min && t <= t_max) {
             return None;
         }
@@ -342,12 +359,7 @@ impl Scalar for f32 {
         let a = r.shear(&v[0]);
         let b = r.shear(&v[1]);
         let c = r.shear(&v[2]);
-        let [eu, ev, ew] = FloatRay::edges(&a, &b, &c);
-        let det = eu + ev + ew;
-        if det == 0.0 {
-            return (0.0, 0.0);
-        }
-        (ev / det, ew / det)
+        FloatRay::solve(&a, &b, &c).map_or((0.0, 0.0), |(_, u, v)| (u, v))
     }
 
     fn sphere_t(

@@ -1,0 +1,41 @@
+//! Cases found on the shared scenes, kept so they stay fixed.
+
+use raykernel::{Ray, Triangle};
+
+/// Long, thin, axis-flat slivers from sponza (triangles 10474 and 62480): the f32 edge
+/// functions keep too few bits for an accurate `t`, which once pushed the hit point outside
+/// the triangle's own box and dropped a real hit. Expected values are from an f64 solve.
+#[test]
+fn sponza_slivers_are_hit_with_accurate_t() {
+    let cases = [
+        (
+            [
+                [0.00724, 5.86330986, -2.41851091],
+                [-10.8127594, 5.86330986, -2.41850996],
+                [-10.8127594, 5.84830999, -2.41850996],
+            ],
+            [0.655276358127594, 0.6132783889770508, -0.4410243332386017],
+            5.4838475f64,
+        ),
+        (
+            [
+                [-0.58286798, 4.89562082, -2.5185101],
+                [-0.290360004, 4.95380402, -2.5185101],
+                [-10.9127598, 5.72331095, -2.5185101],
+            ],
+            [0.6343224048614502, 0.5914830565452576, -0.49777793884277344],
+            5.0595053,
+        ),
+    ];
+    for (verts, dir, t_exact) in cases {
+        let tri = Triangle::<f32>::from_f32(verts).unwrap();
+        let ray = Ray::<f32>::from_f32([-11.0, 2.5, 0.0], dir, 0.0, f32::INFINITY).unwrap();
+        let (t, _, _) = tri
+            .intersect(&ray)
+            .unwrap_or_else(|| panic!("missed {verts:?}"));
+        assert!(
+            (t as f64 - t_exact).abs() < 2e-6 * t_exact,
+            "t = {t}, want {t_exact}"
+        );
+    }
+}
