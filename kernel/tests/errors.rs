@@ -411,6 +411,14 @@ fn ray_error_cases<S: TestScalar>() {
             "{} {bad:?}",
             S::NAME
         );
+        // Both wrong: the origin is reported first, in every mode.
+        let zero = S::array_to_vec([c(0.0); 3]);
+        assert_eq!(
+            Ray::<S>::new(org, zero).err(),
+            Some(RayError::Origin(error)),
+            "{}",
+            S::NAME
+        );
     }
 }
 

@@ -303,6 +303,7 @@ impl Scalar for I16F16 {
     }
 
     fn ray_data(origin: [Self; 3], dir: [Self; 3]) -> Result<FixedRay, RayError> {
+        Self::check_point(origin).map_err(RayError::Origin)?;
         let unit = super::float::unit_dir_f64([dir[0].0 as f64, dir[1].0 as f64, dir[2].0 as f64])?;
         FixedRay::new(origin, unit)
     }
