@@ -23,14 +23,14 @@ pub struct FloatRay {
     origin: [f32; 3],
     /// Unit direction.
     dir: [f32; 3],
-    /// `1 / dir`, `±inf` for `±0` components (sign preserved, never NaN).
-    inv: [f32; 3],
+    /// `1 / dir`, `±inf` for `±0` components (sign preserved, never NaN); z repeated in lane 3.
+    inv: [f32; 4],
     /// Origin as seen from the boxes' `lo` planes: moved up by the margin, which enlarges
     /// every box downwards, so near distances are never overestimated nor far ones
     /// underestimated.
-    o_lo: [f32; 3],
+    o_lo: [f32; 4],
     /// Origin as seen from the boxes' `hi` planes: moved down by the margin.
-    o_hi: [f32; 3],
+    o_hi: [f32; 4],
     /// Watertight test: axis permutation (kx, ky, kz), each < 3; kept as indices into `[f32; 4]`.
     k: [usize; 3],
     /// Watertight test: shear constants Sx, Sy, Sz.
@@ -103,16 +103,17 @@ impl FloatRay {
 
         let o_max = abs(origin[0]).max_of(abs(origin[1])).max_of(abs(origin[2]));
         let delta = o_max * MARGIN;
-        let mut inv = [0.0; 3];
-        let mut o_lo = [0.0; 3];
-        let mut o_hi = [0.0; 3];
-        for i in 0..3 {
-            inv[i] = 1.0 / dir[i];
+        let mut inv = [0.0; 4];
+        let mut o_lo = [0.0; 4];
+        let mut o_hi = [0.0; 4];
+        for i in 0..4 {
+            let i3 = i.min(2);
+            inv[i] = 1.0 / dir[i3];
             // Seen from shifted origins the box grows by `delta` on each side, whichever plane
             // is near: `lo - (o + delta)` and `hi - (o - delta)`. For a zero component an origin
             // inside the slab then sees `-inf` and `+inf`, never `0 * inf`.
-            o_lo[i] = shift(origin[i], delta, true);
-            o_hi[i] = shift(origin[i], delta, false);
+            o_lo[i] = shift(origin[i3], delta, true);
+            o_hi[i] = shift(origin[i3], delta, false);
         }
 
         // Watertight test: kz is the dominant axis; swapping kx/ky keeps the winding.
@@ -296,22 +297,28 @@ impl Scalar for f32 {
 
     #[inline(always)]
     fn slab(r: &FloatRay, lo: &[f32; 3], hi: &[f32; 3], t_min: f32, t_max: f32) -> Option<f32> {
+        // Four lanes (z repeated) so the lane-wise steps compile to whole-vector instructions;
+        // each lane is the same IEEE operation as scalar code, so the bits do not change.
+        let lo = [lo[0], lo[1], lo[2], lo[2]];
+        let hi = [hi[0], hi[1], hi[2], hi[2]];
+        let mut near = [0.0f32; 4];
+        let mut far = [0.0f32; 4];
+        for i in 0..4 {
+            let a = (lo[i] - r.o_lo[i]) * r.inv[i];
+            let b = (hi[i] - r.o_hi[i]) * r.inv[i];
+            // 0 * inf = NaN happens only for a zero direction component whose shifted origin
+            // lies exactly on a plane, i.e. the parallel ray is just outside the slab. A NaN in
+            // `a` makes `near` +inf (box rejected: exact); a NaN in `b` passes through and is
+            // ignored below, since comparisons with NaN are false (box kept: conservative).
+            // (`a < b` and `a > b` are distinct predicates, so both selects stay branch-free.)
+            near[i] = if a < b { a } else { b };
+            far[i] = if a > b { a } else { b };
+        }
         let mut t_near = t_min;
         let mut t_far = t_max;
         for i in 0..3 {
-            let a = (lo[i] - r.o_lo[i]) * r.inv[i];
-            let b = (hi[i] - r.o_hi[i]) * r.inv[i];
-            // 0 * inf = NaN happens only when a zero-direction ray's shifted origin lies exactly
-            // on a plane. Every comparison below is false for NaN and keeps the other operand,
-            // so such an axis constrains nothing (the conservative answer).
-            let near = if b < a { b } else { a };
-            let far = if a > b { a } else { b };
-            if near > t_near {
-                t_near = near;
-            }
-            if far < t_far {
-                t_far = far;
-            }
+            t_near = if near[i] > t_near { near[i] } else { t_near };
+            t_far = if far[i] < t_far { far[i] } else { t_far };
         }
         if t_near <= Self::widen(t_far) {
             Some(t_near)
