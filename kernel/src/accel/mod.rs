@@ -58,10 +58,12 @@ pub trait Accel<S: Scalar> {
     fn occluded_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> bool;
 
     /// Closest hit.
+    #[inline]
     fn intersect(&self, ray: &Ray<S>) -> Option<Hit<S>> {
         self.intersect_counted(ray, &mut NoStats)
     }
     /// Any hit.
+    #[inline]
     fn occluded(&self, ray: &Ray<S>) -> bool {
         self.occluded_counted(ray, &mut NoStats)
     }

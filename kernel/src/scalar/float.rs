@@ -169,7 +169,7 @@ impl FloatRay {
     /// nearly edge-on sliver can carry a `t` far off (det is tiny); rejecting it keeps every
     /// reported hit inside the boxes traversal tests, so no accelerator can cull a hit that
     /// brute force would report.
-    #[inline]
+    #[inline(always)]
     fn point_near_box(&self, t: f32, v: &[[f32; 3]; 3]) -> bool {
         let mut m = abs(self.origin[0])
             .max_of(abs(self.origin[1]))
@@ -190,7 +190,7 @@ impl FloatRay {
     /// with the edge functions evaluated in `f64` (exact products, one rounding each).
     /// `None` if the determinant is zero there. NaN (only from overflow) fails callers' range
     /// tests.
-    #[inline]
+    #[inline(always)]
     fn solve(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> Option<(f32, f32, f32)> {
         let e = |p: &[f32; 3], q: &[f32; 3]| p[0] as f64 * q[1] as f64 - p[1] as f64 * q[0] as f64;
         let (u, v, w) = (e(c, b), e(a, c), e(b, a));

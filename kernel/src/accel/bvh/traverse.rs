@@ -106,6 +106,7 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
 }
 
 impl<S: Scalar, P: Primitive<S>> Accel<S> for Bvh<'_, S, P> {
+    #[inline]
     fn intersect_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Hit<S>> {
         let (t, prim, at) = self.traverse::<false, C>(ray, stats);
         if prim == u32::MAX {
@@ -116,6 +117,7 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for Bvh<'_, S, P> {
         Some(Hit { t, prim, u, v })
     }
 
+    #[inline]
     fn occluded_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> bool {
         self.traverse::<true, C>(ray, stats).1 != u32::MAX
     }
