@@ -40,7 +40,7 @@ pub mod scalar;
 pub use accel::bvh::{self, Bvh, Node};
 pub use accel::{Accel, Counters, Linear, NoStats, TraversalStats};
 pub use error::{Arena, BuildError, PointError, RayError};
-pub use geom::{Aabb, Hit, Primitive, Ray, Sphere, Triangle};
+pub use geom::{spawn, Aabb, Hit, Primitive, Ray, Sphere, Triangle};
 pub use glam;
 pub use scalar::{Scalar, Vec3x, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16};
 

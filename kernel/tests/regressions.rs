@@ -41,3 +41,31 @@ fn sponza_slivers_are_hit_with_accurate_t() {
         );
     }
 }
+
+/// Found by the fuzz target `accel_equivalence`: a ray through a vertex of a triangle with
+/// subnormal coordinates got `v = -9.7e-44` (the f64 solve's sign disagreed with the f32 edge
+/// functions that accepted the hit). Barycentrics of a hit are now clamped to `[0, 1]`, as the
+/// fixed-point mode already did.
+#[test]
+fn barycentrics_of_a_hit_stay_in_unit_interval() {
+    let tri = Triangle::<f32>::from_f32([
+        [8192.0, -25.25, -2.5743157e-22],
+        [2.2864516e-37, 9.1482e-41, 0.0],
+        [8192.0, 8192.0, 8192.0],
+    ])
+    .unwrap();
+    let ray = Ray::<f32>::from_f32(
+        [0.0, 0.0, 0.0],
+        [0.99999523, -0.0030822607, -3.1424604e-26],
+        0.0,
+        f32::INFINITY,
+    )
+    .unwrap();
+    let (t, u, v) = tri
+        .intersect(&ray)
+        .expect("the ray passes through vertex 1");
+    assert!(t >= 0.0);
+    for w in [u, v] {
+        assert!((0.0..=1.0).contains(&w), "barycentric {w} (u {u}, v {v})");
+    }
+}

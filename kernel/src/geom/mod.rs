@@ -4,6 +4,7 @@ mod aabb;
 mod hit;
 mod primitive;
 mod ray;
+pub mod spawn;
 
 pub use aabb::Aabb;
 pub use hit::{closer, Hit};

@@ -366,7 +366,10 @@ impl Scalar for f32 {
         let a = r.shear(&v[0]);
         let b = r.shear(&v[1]);
         let c = r.shear(&v[2]);
-        FloatRay::solve(&a, &b, &c).map_or((0.0, 0.0), |(_, u, v)| (u, v))
+        // Clamped to [0, 1] as in fixed point: the f64 solve can disagree in sign with the f32
+        // edge functions that accepted the hit by a few subnormals (found by fuzzing).
+        let unit = |w: f32| if w > 0.0 { w.min_of(1.0) } else { 0.0 };
+        FloatRay::solve(&a, &b, &c).map_or((0.0, 0.0), |(_, u, v)| (unit(u), unit(v)))
     }
 
     fn sphere_t(

@@ -1,0 +1,33 @@
+//! Arbitrary bytes -> the host's OBJ reader and ray/hit file readers. None may panic; what they
+//! accept must convert to kernel triangles (or give a typed error) and re-encode to the same
+//! bytes.
+#![no_main]
+
+use host::rayfile::{encode_hits, encode_rays, parse_hits, parse_rays};
+use libfuzzer_sys::fuzz_target;
+use raykernel::I16F16;
+use std::path::Path;
+
+fuzz_target!(|data: &[u8]| {
+    let path = Path::new("fuzz.obj");
+    if let Ok(mesh) = host::parse_obj(data, path) {
+        assert_eq!(mesh.triangles.len(), mesh.triangle_lines.len());
+        assert_eq!(mesh.positions.len(), mesh.position_lines.len());
+        for t in &mesh.triangles {
+            for &i in t {
+                assert!(
+                    (i as usize) < mesh.positions.len(),
+                    "index {i} out of range"
+                );
+            }
+        }
+        let _ = mesh.kernel_triangles::<f32>(path);
+        let _ = mesh.kernel_triangles::<I16F16>(path);
+    }
+    if let Ok(rays) = parse_rays(data, Path::new("fuzz.rays")) {
+        assert_eq!(encode_rays(&rays), data, "ray file does not round-trip");
+    }
+    if let Ok(hits) = parse_hits(data, Path::new("fuzz.hits")) {
+        assert_eq!(encode_hits(&hits), data, "hit file does not round-trip");
+    }
+});
