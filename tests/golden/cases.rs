@@ -1,0 +1,393 @@
+//! Golden cases, shared by the host test (`kernel/tests/golden.rs`) and the on-target tests
+//! (`tests/qemu`): a generated mesh and sphere set, a fixed ray set, and FNV-1a hashes of what
+//! the kernel computes on them. Both sides compile this same file (`#[path]`), so they hash the
+//! same inputs the same way; the expected values live in one place, `kernel_hashes.txt`.
+//!
+//! `no_std`, no allocation, no recursion: everything fits the Cortex-M0's 16 KB of RAM.
+//! To add a case (e.g. a render hash), add its name to [`NAMES`] and its computation to
+//! [`compute`], then rewrite the table with `BLESS=1 cargo test -p raykernel --test golden`.
+#![allow(dead_code)]
+
+use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
+use raykernel::{Accel, Bvh, Hit, Linear, Node, Primitive, Ray, Scalar, Sphere, Triangle, I16F16};
+
+/// Triangles of the level-1 icosphere.
+pub const ICO_TRIS: usize = 80;
+/// Rays in the fixed ray set.
+pub const RAY_COUNT: usize = 96;
+/// Spheres in the sphere set.
+pub const SPHERE_COUNT: usize = 8;
+/// Icosphere centre and radius (off the origin, so no coordinate is trivially symmetric).
+const CENTER: [f32; 3] = [0.375, -0.25, 0.625];
+const RADIUS: f32 = 2.0;
+
+/// Every golden case, in file order.
+pub const NAMES: [&str; 12] = [
+    "rays_f32",
+    "rays_fixed",
+    "linear_f32",
+    "linear_fixed",
+    "spheres_f32",
+    "spheres_fixed",
+    "tree_f32_sah",
+    "tree_f32_median",
+    "tree_f32_midpoint",
+    "tree_fixed_sah",
+    "tree_fixed_median",
+    "tree_fixed_midpoint",
+];
+
+/// What went wrong while computing a case.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fail {
+    /// No case has this name.
+    UnknownCase,
+    /// The kernel rejected generated input (ray `index`, or primitive `index`).
+    Rejected { index: usize },
+    /// A build failed.
+    Build,
+    /// `validate` rejected a built tree.
+    Invalid,
+    /// A query through the BVH differed from brute force on ray `index`.
+    Differs { index: usize },
+}
+
+/// 64-bit FNV-1a over little-endian words.
+#[derive(Clone, Copy, Debug)]
+pub struct Fnv(u64);
+
+impl Default for Fnv {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Fnv {
+    pub const fn new() -> Self {
+        Self(0xcbf2_9ce4_8422_2325)
+    }
+    pub fn u32(&mut self, x: u32) {
+        for b in x.to_le_bytes() {
+            self.0 ^= b as u64;
+            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+    pub fn finish(self) -> u64 {
+        self.0
+    }
+}
+
+/// The exact bits of a mode's value: `f32::to_bits`, or the raw `i32` of fixed point.
+pub trait Bits: Scalar {
+    fn bits(self) -> u32;
+}
+impl Bits for f32 {
+    fn bits(self) -> u32 {
+        self.to_bits()
+    }
+}
+impl Bits for I16F16 {
+    fn bits(self) -> u32 {
+        self.raw() as u32
+    }
+}
+
+/// SplitMix64: tiny, seeded, identical on every platform.
+pub struct Rng(u64);
+
+impl Rng {
+    pub const fn new(seed: u64) -> Self {
+        Self(seed)
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    /// Uniform in `[lo, hi)` from 24 random bits (exact conversions only).
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * ((self.next_u64() >> 40) as f32 / 16_777_216.0)
+    }
+    /// A direction (not normalised: the kernel normalises) with no tiny length.
+    pub fn dir(&mut self) -> [f32; 3] {
+        loop {
+            let v = [0; 3].map(|_| self.range(-1.0, 1.0));
+            if v[0] * v[0] + v[1] * v[1] + v[2] * v[2] > 0.01 {
+                return v;
+            }
+        }
+    }
+}
+
+fn normalize(p: [f32; 3]) -> [f32; 3] {
+    let n = libm::sqrtf(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    p.map(|x| x / n)
+}
+
+/// Midpoint of an edge on the unit sphere; symmetric in its arguments (IEEE `+` commutes), so
+/// neighbouring faces share the exact vertex and the mesh stays closed.
+fn mid(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    normalize([a[0] + b[0], a[1] + b[1], a[2] + b[2]])
+}
+
+/// Triangle `k` (of [`ICO_TRIS`]) of the level-1 icosphere, as `f32` vertices, scaled and
+/// moved. Computed one at a time, so callers need no second copy of the mesh.
+pub fn ico_triangle(k: usize) -> [[f32; 3]; 3] {
+    const FACES: [[usize; 3]; 20] = [
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    let phi = (1.0 + libm::sqrtf(5.0)) * 0.5;
+    let v: [[f32; 3]; 12] = [
+        [-1.0, phi, 0.0],
+        [1.0, phi, 0.0],
+        [-1.0, -phi, 0.0],
+        [1.0, -phi, 0.0],
+        [0.0, -1.0, phi],
+        [0.0, 1.0, phi],
+        [0.0, -1.0, -phi],
+        [0.0, 1.0, -phi],
+        [phi, 0.0, -1.0],
+        [phi, 0.0, 1.0],
+        [-phi, 0.0, -1.0],
+        [-phi, 0.0, 1.0],
+    ];
+    let [a, b, c] = FACES[(k / 4) % 20].map(|i| normalize(v[i]));
+    let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+    let t = match k % 4 {
+        0 => [a, ab, ca],
+        1 => [ab, b, bc],
+        2 => [ca, bc, c],
+        _ => [ab, bc, ca],
+    };
+    t.map(|p| core::array::from_fn(|i| CENTER[i] + RADIUS * p[i]))
+}
+
+/// The icosphere in mode `S`, written into `out`.
+pub fn icosphere<S: Scalar>(out: &mut [Triangle<S>; ICO_TRIS]) -> Result<(), Fail> {
+    for (index, o) in out.iter_mut().enumerate() {
+        *o = Triangle::from_f32(ico_triangle(index)).map_err(|_| Fail::Rejected { index })?;
+    }
+    Ok(())
+}
+
+/// An all-zero mesh buffer to fill with [`icosphere`].
+pub fn empty_mesh<S: Scalar>() -> [Triangle<S>; ICO_TRIS] {
+    [Triangle {
+        v: [[S::ZERO; 3]; 3],
+    }; ICO_TRIS]
+}
+
+/// Eight spheres of different sizes, some overlapping.
+pub fn spheres<S: Scalar>() -> Result<[Sphere<S>; SPHERE_COUNT], Fail> {
+    let mut rng = Rng::new(0x5eed_5f3e_7e5e_0001);
+    let mut out = [Sphere {
+        center: [S::ZERO; 3],
+        radius: S::ZERO,
+    }; SPHERE_COUNT];
+    for (index, s) in out.iter_mut().enumerate() {
+        let c = [0; 3].map(|_| rng.range(-2.0, 2.0));
+        let r = rng.range(0.25, 1.25);
+        let mut center = [S::ZERO; 3];
+        for k in 0..3 {
+            center[k] = S::coord_from_f32(c[k]).map_err(|_| Fail::Rejected { index })?;
+        }
+        *s = Sphere {
+            center,
+            radius: S::coord_from_f32(r).map_err(|_| Fail::Rejected { index })?,
+        };
+        s.check().map_err(|_| Fail::Rejected { index })?;
+    }
+    Ok(out)
+}
+
+/// Ray `i` of the fixed set as (origin, direction, t_min, t_max): every fourth starts inside
+/// the sphere, the others start 6 to 8 units out and aim near it (some miss); some have a
+/// bounded interval.
+pub fn ray_spec(i: usize) -> ([f32; 3], [f32; 3], f32, f32) {
+    let mut rng = Rng::new(0x0123_4567_89ab_cdef ^ (i as u64).wrapping_mul(0x9e37_79b9));
+    let inside = i % 4 < 1;
+    let (o, d) = if inside {
+        let o = [0; 3].map(|_| rng.range(-0.75, 0.75));
+        (core::array::from_fn(|k| CENTER[k] + o[k]), rng.dir())
+    } else {
+        let out = rng.dir();
+        let dist = rng.range(3.0, 4.0);
+        let o: [f32; 3] = core::array::from_fn(|k| CENTER[k] + dist * out[k]);
+        let target: [f32; 3] = core::array::from_fn(|k| CENTER[k] + rng.range(-2.5, 2.5));
+        (o, core::array::from_fn(|k| target[k] - o[k]))
+    };
+    let (t_min, t_max) = match i % 8 {
+        3 => (0.0, rng.range(1.0, 6.0)),
+        5 => (rng.range(0.0, 2.0), f32::INFINITY),
+        _ => (0.0, f32::INFINITY),
+    };
+    (o, d, t_min, t_max)
+}
+
+/// Ray `i` in mode `S`.
+pub fn ray<S: Scalar>(i: usize) -> Result<Ray<S>, Fail> {
+    let (o, d, t_min, t_max) = ray_spec(i);
+    Ray::from_f32(o, d, t_min, t_max).map_err(|_| Fail::Rejected { index: i })
+}
+
+fn hash_hit<S: Bits>(h: &mut Fnv, hit: &Option<Hit<S>>) {
+    match hit {
+        Some(hit) => {
+            h.u32(hit.t.bits());
+            h.u32(hit.prim);
+            h.u32(hit.u.bits());
+            h.u32(hit.v.bits());
+        }
+        None => h.u32(u32::MAX),
+    }
+}
+
+/// The bits of every ray's origin, direction and interval as the constructors store them.
+pub fn hash_rays<S: Bits>() -> Result<u64, Fail> {
+    let mut h = Fnv::new();
+    for i in 0..RAY_COUNT {
+        let r = ray::<S>(i)?;
+        for x in S::vec_to_array(r.origin())
+            .into_iter()
+            .chain(S::vec_to_array(r.dir()))
+            .chain([r.t_min(), r.t_max()])
+        {
+            h.u32(x.bits());
+        }
+    }
+    Ok(h.finish())
+}
+
+/// Brute-force closest hit and any-hit of every ray.
+pub fn hash_queries<S: Bits, A: Accel<S>>(accel: &A) -> Result<u64, Fail> {
+    let mut h = Fnv::new();
+    for i in 0..RAY_COUNT {
+        let r = ray::<S>(i)?;
+        hash_hit(&mut h, &accel.intersect(&r));
+        h.u32(accel.occluded(&r) as u32);
+    }
+    Ok(h.finish())
+}
+
+/// Every query through `a` gives the same bits as through `b`.
+pub fn same_queries<S: Bits, A: Accel<S>, B: Accel<S>>(a: &A, b: &B) -> Result<(), Fail> {
+    for index in 0..RAY_COUNT {
+        let r = ray::<S>(index)?;
+        let (ha, hb) = (a.intersect(&r), b.intersect(&r));
+        let bits = |h: Option<Hit<S>>| h.map(|h| (h.t.bits(), h.prim, h.u.bits(), h.v.bits()));
+        if bits(ha) != bits(hb) || a.occluded(&r) != b.occluded(&r) {
+            return Err(Fail::Differs { index });
+        }
+    }
+    Ok(())
+}
+
+/// A built tree: every node's box bits, child/leaf fields, the primitive ids and the depth.
+pub fn hash_tree<S: Bits, P: Primitive<S>>(bvh: &Bvh<'_, S, P>) -> u64 {
+    let mut h = Fnv::new();
+    for n in bvh.nodes() {
+        let b = n.bounds();
+        for x in b.lo.into_iter().chain(b.hi) {
+            h.u32(x.bits());
+        }
+        h.u32(n.first());
+        h.u32(n.count());
+    }
+    for &id in bvh.prim_ids() {
+        h.u32(id);
+    }
+    h.u32(bvh.depth());
+    h.finish()
+}
+
+/// Builds the icosphere with `builder` (leaves of up to 4), validates it, checks every query
+/// against brute force, and hashes the tree.
+pub fn tree_case<S: Bits>(builder: BuilderKind) -> Result<u64, Fail> {
+    let mut tris = empty_mesh::<S>();
+    icosphere(&mut tris)?;
+    let mut nodes = [Node::<S>::EMPTY; nodes_needed(ICO_TRIS)];
+    let mut ids = [0u32; ICO_TRIS];
+    let options = BuildOptions {
+        builder,
+        max_leaf_size: 4,
+    };
+    let bvh = Bvh::build(&tris, &mut nodes, &mut ids, options).map_err(|_| Fail::Build)?;
+    bvh.validate().map_err(|_| Fail::Invalid)?;
+    same_queries(&bvh, &Linear::new(&tris))?;
+    Ok(hash_tree(&bvh))
+}
+
+fn linear_case<S: Bits>() -> Result<u64, Fail> {
+    let mut tris = empty_mesh::<S>();
+    icosphere(&mut tris)?;
+    hash_queries(&Linear::new(&tris))
+}
+
+fn spheres_case<S: Bits>() -> Result<u64, Fail> {
+    let s = spheres::<S>()?;
+    let mut nodes = [Node::<S>::EMPTY; nodes_needed(SPHERE_COUNT)];
+    let mut ids = [0u32; SPHERE_COUNT];
+    let bvh =
+        Bvh::build(&s, &mut nodes, &mut ids, BuildOptions::default()).map_err(|_| Fail::Build)?;
+    bvh.validate().map_err(|_| Fail::Invalid)?;
+    let linear = Linear::new(&s);
+    same_queries(&bvh, &linear)?;
+    hash_queries(&linear)
+}
+
+/// Computes the case called `name`.
+pub fn compute(name: &str) -> Result<u64, Fail> {
+    use BuilderKind::{Median, Midpoint, Sah};
+    match name {
+        "rays_f32" => hash_rays::<f32>(),
+        "rays_fixed" => hash_rays::<I16F16>(),
+        "linear_f32" => linear_case::<f32>(),
+        "linear_fixed" => linear_case::<I16F16>(),
+        "spheres_f32" => spheres_case::<f32>(),
+        "spheres_fixed" => spheres_case::<I16F16>(),
+        "tree_f32_sah" => tree_case::<f32>(Sah),
+        "tree_f32_median" => tree_case::<f32>(Median),
+        "tree_f32_midpoint" => tree_case::<f32>(Midpoint),
+        "tree_fixed_sah" => tree_case::<I16F16>(Sah),
+        "tree_fixed_median" => tree_case::<I16F16>(Median),
+        "tree_fixed_midpoint" => tree_case::<I16F16>(Midpoint),
+        _ => Err(Fail::UnknownCase),
+    }
+}
+
+/// Parses the golden file's `name = 0x<16 hex digits>` lines (`#` starts a comment) and calls
+/// `f(line_number, name, value)` for each. Errors name the first malformed line.
+pub fn parse_golden(text: &str, mut f: impl FnMut(&str, u64)) -> Result<(), usize> {
+    for (no, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let (name, value) = line.split_once('=').ok_or(no + 1)?;
+        let hex = value.trim().strip_prefix("0x").ok_or(no + 1)?;
+        let v = u64::from_str_radix(hex, 16).map_err(|_| no + 1)?;
+        f(name.trim(), v);
+    }
+    Ok(())
+}

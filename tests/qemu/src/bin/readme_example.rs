@@ -1,0 +1,45 @@
+//! The README's embedded example (keep the two in sync): a static arena sized by the kernel's
+//! `const fn`, a build and a traced ray. `cargo xtask qemu` builds and runs it on all three
+//! cores; it exits 0 when the ray hits the nearer triangle.
+#![no_std]
+#![no_main]
+
+use cortex_m_rt::entry;
+use panic_halt as _;
+use raykernel::bvh::{nodes_needed, BuildOptions};
+use raykernel::{Accel, Bvh, Node, Ray, Triangle};
+
+const N: usize = 2; // triangles in the scene
+static TRIS: [Triangle<f32>; N] = [
+    Triangle {
+        v: [[-1.0, -1.0, 5.0], [1.0, -1.0, 5.0], [0.0, 1.0, 5.0]],
+    },
+    Triangle {
+        v: [[-1.0, -1.0, 9.0], [1.0, -1.0, 9.0], [0.0, 1.0, 9.0]],
+    },
+];
+
+#[entry]
+fn main() -> ! {
+    // Static arenas, sized at compile time (2N nodes of 32 bytes, N ids).
+    let nodes =
+        cortex_m::singleton!(: [Node<f32>; nodes_needed(N)] = [Node::EMPTY; nodes_needed(N)]);
+    let ids = cortex_m::singleton!(: [u32; N] = [0; N]);
+    let (Some(nodes), Some(ids)) = (nodes, ids) else {
+        exit(2)
+    };
+    let Ok(bvh) = Bvh::build(&TRIS, nodes, ids, BuildOptions::default()) else {
+        exit(3)
+    };
+    let Ok(ray) = Ray::<f32>::from_f32([0.0; 3], [0.0, 0.0, 1.0], 0.0, f32::INFINITY) else {
+        exit(4)
+    };
+    match bvh.intersect(&ray) {
+        Some(hit) if hit.prim == 0 && hit.t == 5.0 => exit(0),
+        _ => exit(1),
+    }
+}
+
+fn exit(code: i32) -> ! {
+    semihosting::process::exit(code)
+}

@@ -1,0 +1,403 @@
+//! Repository tasks, run from the repository root:
+//!
+//! - `cargo xtask qemu`: the on-target tests (`tests/qemu`, defmt-test under QEMU) on the
+//!   Cortex-M4F, M3 and M0, the README's embedded example on all three, and the panic-freedom
+//!   link check; prints a per-target summary and a final `N passed, M failed` line.
+//! - `cargo xtask panic-check`: only the panic-freedom link check (release, all three targets);
+//!   on failure, lists the kernel source lines that still reach a panic.
+//! - `cargo xtask size`: the footprint table of the README (code size of a build + traverse
+//!   probe, arena bytes per triangle, stack high-water marks measured on target).
+//!
+//! Cargo reads `.cargo/config.toml` from the current directory, so every on-target command runs
+//! inside `tests/qemu`.
+
+#[path = "../../tests/golden/cases.rs"]
+#[allow(dead_code, clippy::all)]
+mod cases;
+
+use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
+use raykernel::{Bvh, Node, Triangle};
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode, Stdio};
+
+/// Target, core, QEMU machine and CPU.
+const TARGETS: [(&str, &str, &str, &str); 3] = [
+    (
+        "thumbv7em-none-eabihf",
+        "Cortex-M4F",
+        "mps2-an386",
+        "cortex-m4",
+    ),
+    (
+        "thumbv7m-none-eabi",
+        "Cortex-M3",
+        "lm3s6965evb",
+        "cortex-m3",
+    ),
+    ("thumbv6m-none-eabi", "Cortex-M0", "microbit", "cortex-m0"),
+];
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let ok = match args.first().map(String::as_str) {
+        Some("qemu") => qemu(),
+        Some("panic-check") => {
+            let r = panic_check();
+            println!("{} passed, {} failed", r.0, r.1);
+            r.1 == 0
+        }
+        Some("size") => size(),
+        _ => {
+            eprintln!("usage: cargo xtask <qemu | panic-check | size>");
+            false
+        }
+    };
+    if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
+}
+
+fn qemu_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/qemu")
+}
+
+/// `cargo` inside tests/qemu, without the caller's RUSTFLAGS (they would replace the target
+/// config's linker scripts).
+fn cargo(args: &[&str]) -> Command {
+    let mut c = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    c.current_dir(qemu_dir())
+        .args(args)
+        .env_remove("RUSTFLAGS")
+        .env_remove("CARGO_ENCODED_RUSTFLAGS")
+        .env_remove("CARGO_TARGET_DIR");
+    c
+}
+
+/// Runs `c`, echoing its output; returns (success, stdout + stderr).
+fn run(mut c: Command) -> (bool, String) {
+    match c.stdout(Stdio::piped()).stderr(Stdio::piped()).output() {
+        Ok(out) => {
+            let text = format!(
+                "{}{}",
+                String::from_utf8_lossy(&out.stderr),
+                String::from_utf8_lossy(&out.stdout)
+            );
+            print!("{text}");
+            (out.status.success(), text)
+        }
+        Err(e) => {
+            println!("cannot run {c:?}: {e}");
+            (false, String::new())
+        }
+    }
+}
+
+/// defmt-test's progress: the highest `(i/N)` seen, N, and whether it finished.
+fn progress(output: &str) -> (usize, usize, bool) {
+    let (mut last, mut total) = (0, 0);
+    for line in output.lines() {
+        let Some(rest) = line.trim().strip_prefix('(') else {
+            continue;
+        };
+        let Some((i, rest)) = rest.split_once('/') else {
+            continue;
+        };
+        let Some((n, rest)) = rest.split_once(')') else {
+            continue;
+        };
+        if let (Ok(i), Ok(n), true) = (i.parse(), n.parse(), rest.contains("running")) {
+            last = i;
+            total = n;
+        }
+    }
+    (last, total, output.contains("all tests passed!"))
+}
+
+fn elf(target: &str, profile: &str, bin: &str) -> PathBuf {
+    qemu_dir().join(format!("target/{target}/{profile}/{bin}"))
+}
+
+fn qemu() -> bool {
+    let (mut passed, mut failed) = (0usize, 0usize);
+    let mut summary = Vec::new();
+    for (target, core, machine, cpu) in TARGETS {
+        println!("\n=== on-target tests: {core} ({target}, QEMU {machine}) ===");
+        let (ok, out) = run(cargo(&["test", "--target", target]));
+        let (last, total, finished) = progress(&out);
+        let ok = ok && finished && total > 0 && last == total;
+        let (p, f) = if ok {
+            (total, 0)
+        } else {
+            // The failing test stopped the run: it and the ones after it count as failed.
+            let p = last.saturating_sub(1);
+            (p, total.max(1) - p)
+        };
+        passed += p;
+        failed += f;
+        summary.push(format!(
+            "{core:<11} {target:<22} tests ({p}/{total}) {}",
+            if ok { "pass" } else { "FAIL" }
+        ));
+
+        println!("\n=== README example: {core} ===");
+        let built = run(cargo(&[
+            "build",
+            "--release",
+            "--bin",
+            "readme_example",
+            "--target",
+            target,
+        ]))
+        .0;
+        let ran = built && {
+            let mut q = Command::new("timeout");
+            q.args(["60", "qemu-system-arm", "-machine", machine, "-cpu", cpu])
+                .args(["-display", "none", "-semihosting-config"])
+                .arg("enable=on,target=native")
+                .arg("-kernel")
+                .arg(elf(target, "release", "readme_example"));
+            run(q).0
+        };
+        if ran {
+            passed += 1;
+        } else {
+            failed += 1;
+        }
+        summary.push(format!(
+            "{core:<11} {target:<22} readme_example {}",
+            if ran { "pass" } else { "FAIL" }
+        ));
+    }
+    println!("\n=== panic-freedom link check ===");
+    let (p, f) = panic_check();
+    passed += p;
+    failed += f;
+    summary.push(format!(
+        "{:<34} panic_never ({p}/{}) {}",
+        "all cores",
+        p + f,
+        if f == 0 { "pass" } else { "FAIL" }
+    ));
+    println!("\n=== summary ===");
+    for line in &summary {
+        println!("{line}");
+    }
+    println!("{passed} passed, {failed} failed");
+    failed == 0
+}
+
+/// Release-links `panic_never` for every target; returns (passed, failed).
+fn panic_check() -> (usize, usize) {
+    let (mut passed, mut failed) = (0, 0);
+    for (target, core, _, _) in TARGETS {
+        let args = [
+            "build",
+            "--release",
+            "--bin",
+            "panic_never",
+            "--features",
+            "panic-check",
+            "--target",
+            target,
+        ];
+        if run(cargo(&args)).0 {
+            println!("{core} ({target}): panic_never links: no reachable panic path");
+            passed += 1;
+        } else {
+            failed += 1;
+            println!("{core} ({target}): a panic path is reachable; call sites:");
+            let mut list = args.to_vec();
+            list[5] = "list-panics";
+            if run(cargo(&list)).0 {
+                for site in panic_sites(&elf(target, "release", "panic_never")) {
+                    println!("  {site}");
+                }
+            }
+        }
+    }
+    (passed, failed)
+}
+
+/// Source lines (innermost kernel frame of the inlining chain) of calls into core's panic
+/// functions, from `arm-none-eabi-objdump` and `arm-none-eabi-addr2line`.
+fn panic_sites(elf: &Path) -> Vec<String> {
+    let Ok(dis) = Command::new("arm-none-eabi-objdump")
+        .args(["-d", "--no-show-raw-insn"])
+        .arg(elf)
+        .output()
+    else {
+        return vec!["(arm-none-eabi-objdump not found)".into()];
+    };
+    let dis = String::from_utf8_lossy(&dis.stdout);
+    let is_panic = |s: &str| {
+        [
+            "panicking",
+            "slice_index_fail",
+            "unwrap_failed",
+            "expect_failed",
+            "assert_failed",
+        ]
+        .iter()
+        .any(|p| s.contains(p))
+    };
+    let mut func = String::new();
+    let mut addrs = Vec::new();
+    for line in dis.lines() {
+        if let Some(name) = line.strip_suffix(">:").and_then(|l| l.split_once(" <")) {
+            func = name.1.to_string();
+            continue;
+        }
+        let t = line.trim_start();
+        let (Some((addr, rest)), false) = (t.split_once(':'), is_panic(&func)) else {
+            continue;
+        };
+        let rest = rest.trim_start();
+        if (rest.starts_with("bl") || rest.starts_with("b.w") || rest.starts_with("b\t"))
+            && rest.contains('<')
+            && is_panic(rest)
+        {
+            addrs.push(addr.to_string());
+        }
+    }
+    let mut sites = Vec::new();
+    for a in addrs {
+        let Ok(out) = Command::new("arm-none-eabi-addr2line")
+            .args(["-i", "-e"])
+            .arg(elf)
+            .arg(&a)
+            .output()
+        else {
+            continue;
+        };
+        let out = String::from_utf8_lossy(&out.stdout);
+        let site = out
+            .lines()
+            .find(|l| l.contains("/kernel/src/"))
+            .or_else(|| out.lines().next())
+            .unwrap_or("?")
+            .split(" (")
+            .next()
+            .unwrap_or("?")
+            .to_string();
+        if !sites.contains(&site) {
+            sites.push(site);
+        }
+    }
+    sites.sort();
+    sites
+}
+
+/// `(.text, .rodata)` of an ELF, from `arm-none-eabi-size -A`.
+fn sections(elf: &Path) -> Option<(u64, u64)> {
+    let out = Command::new("arm-none-eabi-size")
+        .arg("-A")
+        .arg(elf)
+        .output()
+        .ok()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let get = |name: &str| {
+        text.lines()
+            .find(|l| l.split_whitespace().next() == Some(name))
+            .and_then(|l| l.split_whitespace().nth(1)?.parse().ok())
+    };
+    Some((get(".text")?, get(".rodata")?))
+}
+
+/// Arena bytes (nodes in use + primitive ids) per triangle for each builder, leaves of up to 4.
+fn arena_per_tri(tris: &[Triangle<f32>]) -> Vec<(BuilderKind, f64)> {
+    let mut out = Vec::new();
+    for builder in BuilderKind::ALL {
+        let mut nodes = vec![Node::<f32>::EMPTY; nodes_needed(tris.len())];
+        let mut ids = vec![0u32; tris.len()];
+        let options = BuildOptions {
+            builder,
+            max_leaf_size: 4,
+        };
+        if let Ok(bvh) = Bvh::build(tris, &mut nodes, &mut ids, options) {
+            out.push((builder, bvh.bytes_used() as f64 / tris.len() as f64));
+        }
+    }
+    out
+}
+
+/// A 64×64 heightfield (8192 triangles) of a smooth bump: a larger generated mesh.
+fn heightfield() -> Vec<Triangle<f32>> {
+    const N: usize = 64;
+    let h = |i: usize, j: usize| {
+        let (x, y) = (i as f32 / N as f32 - 0.5, j as f32 / N as f32 - 0.5);
+        libm::cosf(6.0 * x) * libm::sinf(5.0 * y)
+    };
+    let p = |i: usize, j: usize| [i as f32, j as f32, 8.0 * h(i, j)];
+    let mut out = Vec::with_capacity(2 * N * N);
+    for i in 0..N {
+        for j in 0..N {
+            out.push(Triangle {
+                v: [p(i, j), p(i + 1, j), p(i, j + 1)],
+            });
+            out.push(Triangle {
+                v: [p(i + 1, j), p(i + 1, j + 1), p(i, j + 1)],
+            });
+        }
+    }
+    out
+}
+
+fn size() -> bool {
+    let mut ok = true;
+    let mut rows = Vec::new();
+    for (target, core, _, _) in TARGETS {
+        println!("\n=== {core} ({target}) ===");
+        let built = run(cargo(&[
+            "build",
+            "--release",
+            "--bin",
+            "size_probe",
+            "--target",
+            target,
+        ]))
+        .0;
+        let secs = built
+            .then(|| sections(&elf(target, "release", "size_probe")))
+            .flatten();
+        let (ran, out) = run(cargo(&["test", "--release", "--target", target]));
+        let stack = out.lines().find_map(|l| {
+            l.split_once("stack high-water: ")
+                .map(|(_, s)| s.to_string())
+        });
+        ok &= secs.is_some() && ran && stack.is_some();
+        let (text, rodata) = secs.unwrap_or((0, 0));
+        rows.push(format!(
+            "| {core} (`{target}`) | {text} | {rodata} | {} |",
+            stack.unwrap_or_else(|| "?".into())
+        ));
+    }
+    let mut ico = cases::empty_mesh::<f32>();
+    ok &= cases::icosphere(&mut ico).is_ok();
+    let field = heightfield();
+    println!("\n## Footprint (generated by `cargo xtask size`)\n");
+    println!("Build + traverse probe (`tests/qemu/src/bin/size_probe.rs`: f32 triangles, SAH build, one closest-hit query; release, opt-level \"s\", LTO), and the stack high-water mark of the on-target test `stack_high_water_mark` (icosphere, 80 triangles, SAH build, 96 rays; release):\n");
+    println!("| core | .text B | .rodata B | stack high-water |");
+    println!("|---|---:|---:|---|");
+    for r in &rows {
+        println!("{r}");
+    }
+    println!("\nArena bytes per triangle (nodes in use + primitive ids; `nodes_needed` reserves 68 B/tri), leaves of up to 4:\n");
+    println!("| mesh | triangles | sah | median | midpoint |");
+    println!("|---|---:|---:|---:|---:|");
+    for (name, tris) in [
+        ("icosphere level 1", &ico[..]),
+        ("64×64 heightfield", &field[..]),
+    ] {
+        let v = arena_per_tri(tris);
+        ok &= v.len() == 3;
+        let cells: Vec<String> = v.iter().map(|(_, b)| format!("{b:.1}")).collect();
+        println!("| {name} | {} | {} |", tris.len(), cells.join(" | "));
+    }
+    println!(
+        "\nTraversal stack: MAX_DEPTH × 8 = {} B reserved per query.",
+        raykernel::bvh::MAX_DEPTH * 8
+    );
+    ok
+}
