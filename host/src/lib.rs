@@ -16,6 +16,7 @@ pub mod classify;
 pub mod cli;
 pub mod compare;
 pub mod error;
+pub mod mesh;
 pub mod obj;
 pub mod rayfile;
 pub mod render;

@@ -53,76 +53,14 @@ pub struct Sphere {
 }
 
 pub fn icosphere(center: [f64; 3], radius: f64, levels: u32) -> Sphere {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut p: Vec<[f64; 3]> = vec![
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ];
-    let mut tris: Vec<[usize; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..levels {
-        let mut mid = std::collections::HashMap::new();
-        let mut next = Vec::with_capacity(tris.len() * 4);
-        for [a, b, c] in tris {
-            let mut m = |i: usize, j: usize| {
-                *mid.entry((i.min(j), i.max(j))).or_insert_with(|| {
-                    p.push([
-                        (p[i][0] + p[j][0]) / 2.0,
-                        (p[i][1] + p[j][1]) / 2.0,
-                        (p[i][2] + p[j][2]) / 2.0,
-                    ]);
-                    p.len() - 1
-                })
-            };
-            let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        tris = next;
-    }
-    let positions = p
+    let (unit, triangles) = host::mesh::unit_icosphere(levels);
+    let positions = unit
         .iter()
-        .map(|v| {
-            let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-            [
-                center[0] + radius * v[0] / len,
-                center[1] + radius * v[1] / len,
-                center[2] + radius * v[2] / len,
-            ]
-        })
+        .map(|v| std::array::from_fn(|k| center[k] + radius * v[k]))
         .collect();
     Sphere {
         positions,
-        triangles: tris,
+        triangles,
     }
 }
 
