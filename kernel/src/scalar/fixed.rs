@@ -82,13 +82,14 @@ fn saturate(x: i64) -> I16F16 {
     })
 }
 
-/// `round(n / d)` for `d > 0`, ties away from zero.
+/// `round(n / d)` for `d > 0`, ties away from zero. (Checked division: callers never pass
+/// `d <= 0`, and the check keeps a panic path out of the code; 0 would be the answer.)
 fn div_round(n: i128, d: i128) -> i128 {
     let half = d / 2;
     if n >= 0 {
-        (n + half) / d
+        (n + half).checked_div(d).unwrap_or(0)
     } else {
-        -((-n + half) / d)
+        -(-n + half).checked_div(d).unwrap_or(0)
     }
 }
 
@@ -381,7 +382,8 @@ impl Scalar for I16F16 {
             return None;
         }
         // Raw Q16.16 t = T·2^48-scale / det·2^62-scale · 2^16 = T·2^30 / det; T < 2^93.
-        t_in_range((tt << 30) / det, t_min, t_max)
+        // det > 0 here; the checked division only keeps a panic path out of the code.
+        t_in_range((tt << 30).checked_div(det)?, t_min, t_max)
     }
 
     fn triangle_uv(r: &FixedRay, v: &[[Self; 3]; 3]) -> (Self, Self) {
@@ -392,7 +394,7 @@ impl Scalar for I16F16 {
         }
         let q = |e: i128| {
             let (n, d) = if det < 0 { (-e, -det) } else { (e, det) };
-            I16F16(((n << 16) / d).clamp(0, ONE_RAW as i128) as i32)
+            I16F16(((n << 16).checked_div(d).unwrap_or(0)).clamp(0, ONE_RAW as i128) as i32)
         };
         (q(ev), q(ew))
     }
@@ -420,8 +422,9 @@ impl Scalar for I16F16 {
         }
         let s = disc.unsigned_abs().isqrt() as i128; // scale 2^46
                                                      // t (raw Q16.16) = (-b ∓ s) · 2^30 / a, floored.
-        let near = ((-b - s) << 30).div_euclid(a);
-        let far = ((-b + s) << 30).div_euclid(a);
+                                                     // a > 0 here; the checked divisions only keep a panic path out of the code.
+        let near = ((-b - s) << 30).checked_div_euclid(a)?;
+        let far = ((-b + s) << 30).checked_div_euclid(a)?;
         t_in_range(near, t_min, t_max).or_else(|| t_in_range(far, t_min, t_max))
     }
 

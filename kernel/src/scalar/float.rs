@@ -178,10 +178,12 @@ impl FloatRay {
             m = m.max_of(abs(p[0])).max_of(abs(p[1])).max_of(abs(p[2]));
         }
         let e = m * (MARGIN * 0.5);
+        let [a, b, c] = v;
         (0..3).all(|i| {
+            let i = i.min(2); // a no-op that shows the compiler the bound
             let p = self.origin[i] + t * self.dir[i];
-            let lo = v[0][i].min_of(v[1][i]).min_of(v[2][i]);
-            let hi = v[0][i].max_of(v[1][i]).max_of(v[2][i]);
+            let lo = a[i].min_of(b[i]).min_of(c[i]);
+            let hi = a[i].max_of(b[i]).max_of(c[i]);
             p >= lo - e && p <= hi + e
         })
     }

@@ -2,7 +2,7 @@
 //! nodes replaces recursion. Split decisions use `f32` keys (centroids, areas) in both modes;
 //! `f32` arithmetic is deterministic, so fixed-point trees are identical on every platform too.
 
-use super::select::select_nth;
+use super::select::{select_nth, swap_in};
 use super::{
     nodes_needed, BuildOptions, BuilderKind, Node, FIRST_PAIR, MAX_DEPTH, MAX_LEAF_SIZE,
     MEDIAN_FALLBACK_DEPTH,
@@ -58,7 +58,13 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
     if n == 0 {
         return Ok((0, 0));
     }
-    let ids = &mut ids[..n];
+    let Some(ids) = ids.get_mut(..n) else {
+        return Err(BuildError::ArenaTooSmall {
+            arena: Arena::PrimIds,
+            needed: n,
+            available: ids.len(),
+        });
+    };
     for (slot, id) in ids.iter_mut().zip(0u32..) {
         *slot = id;
     }
@@ -74,23 +80,29 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
     // Nodes are allocated left to right and every position left of the current node is
     // final, so the cache stays intact while `used + 2 <= n + first`; when a split would break
     // that, the ids are written back and the build goes on from the primitives themselves.
-    let mut cached = n >= 2;
-    if cached {
-        for (pos, slot) in nodes[n..2 * n].iter_mut().enumerate() {
+    // (Slices below are taken with `get`: the arena checks above make every range valid, and
+    // the fallbacks, never taken, only keep panic paths out of the code.)
+    let mut cached = false;
+    if let (true, Some(cache)) = (n >= 2, nodes.get_mut(n..2 * n)) {
+        for (pos, slot) in cache.iter_mut().enumerate() {
             let bounds = builder.prim(pos as u32);
             *slot = Node::leaf(bounds, pos as u32, 1);
         }
+        cached = true;
     }
-    let root = if cached {
-        builder.summarize(&nodes[n..2 * n])
-    } else {
-        builder.summarize(ids)
+    let root = match (cached, nodes.get(n..2 * n)) {
+        (true, Some(cache)) => builder.summarize(cache),
+        _ => builder.summarize(ids),
     };
-    nodes[0] = Node::leaf(root.bounds, 0, n as u32);
     let mut used = 1usize;
-    if n > 1 {
-        nodes[1] = Node::EMPTY;
-        used = FIRST_PAIR;
+    match nodes {
+        [root_slot, pad, ..] if n > 1 => {
+            *root_slot = Node::leaf(root.bounds, 0, n as u32);
+            *pad = Node::EMPTY;
+            used = FIRST_PAIR;
+        }
+        [root_slot, ..] => *root_slot = Node::leaf(root.bounds, 0, n as u32),
+        [] => return Ok((0, 0)),
     }
     let mut deepest = 0u32;
     // Pending nodes with their centroid bounds: at most one sibling per level plus the current.
@@ -103,53 +115,64 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
     let mut bins = [[(empty_box::<S>(), 0u32); BINS]; 3];
     while sp > 0 {
         sp -= 1;
-        let Pending {
+        let Some(&Pending {
             index,
             depth,
             centroids,
-        } = stack[sp];
-        let node = nodes[index as usize];
+        }) = stack.get(sp)
+        else {
+            break;
+        };
+        let Some(&node) = nodes.get(index as usize) else {
+            continue;
+        };
         let (first, count) = (node.first as usize, node.count as usize);
         deepest = deepest.max(depth);
         if cached && used + 2 > n + first {
-            for (id, slot) in ids[first..].iter_mut().zip(&nodes[n + first..2 * n]) {
+            let cache = nodes.get(n + first..2 * n).unwrap_or_default();
+            for (id, slot) in ids.iter_mut().skip(first).zip(cache) {
                 *id = slot.first;
             }
             cached = false;
         }
-        let split = if cached {
-            let range = &mut nodes[n + first..n + first + count];
-            let split = builder.split(range, depth as usize, &centroids, &mut bins);
-            if split.is_none() {
-                for (id, slot) in ids[first..first + count].iter_mut().zip(range.iter()) {
-                    *id = slot.first;
+        let range = first..first + count;
+        let split = match (cached, nodes.get_mut(n + first..n + first + count)) {
+            (true, Some(slots)) => {
+                let split = builder.split(slots, depth as usize, &centroids, &mut bins);
+                if split.is_none() {
+                    let leaf_ids = ids.get_mut(range).unwrap_or_default();
+                    for (id, slot) in leaf_ids.iter_mut().zip(slots.iter()) {
+                        *id = slot.first;
+                    }
                 }
+                split
             }
-            split
-        } else {
-            builder.split(
-                &mut ids[first..first + count],
-                depth as usize,
-                &centroids,
-                &mut bins,
-            )
+            _ => match ids.get_mut(range) {
+                Some(leaf_ids) => builder.split(leaf_ids, depth as usize, &centroids, &mut bins),
+                None => None,
+            },
         };
         let Some([left, right]) = split else {
             continue;
         };
         let l = used;
-        used += 2;
-        nodes[l] = Node::leaf(left.bounds, first as u32, left.count as u32);
-        nodes[l + 1] = Node::leaf(
+        let Some([a, b]) = nodes.get_mut(l..l + 2) else {
+            continue;
+        };
+        *a = Node::leaf(left.bounds, first as u32, left.count as u32);
+        *b = Node::leaf(
             right.bounds,
             (first + left.count) as u32,
             right.count as u32,
         );
-        nodes[index as usize] = Node {
-            first: l as u32,
-            count: 0,
-            ..node
-        };
+        used += 2;
+        if let Some(parent) = nodes.get_mut(index as usize) {
+            *parent = Node {
+                first: l as u32,
+                count: 0,
+                ..node
+            };
+        }
         // Right pushed first so the left subtree is built (and laid out) first.
         for (child, side) in [(l + 1, right), (l, left)] {
             if let Some(slot) = stack.get_mut(sp) {
@@ -162,7 +185,7 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
             }
         }
     }
-    for node in &mut nodes[..used] {
+    for node in nodes.iter_mut().take(used) {
         let (lo, hi) = S::pad_bounds(node.lo, node.hi);
         node.lo = lo;
         node.hi = hi;
@@ -222,6 +245,9 @@ struct Builder<'p, S, P> {
 /// Twice the centroid of a box along `axis`, as the `f32` key every split decision uses.
 #[inline(always)]
 fn key<S: Scalar>(b: &Aabb<S>, axis: usize) -> f32 {
+    // `min(2)`: a no-op for the axes callers pass (folded away for constants) that shows the
+    // compiler the bound where the axis comes through a closure.
+    let axis = axis.min(2);
     b.lo[axis].to_f32() * 0.5 + b.hi[axis].to_f32() * 0.5
 }
 
@@ -300,14 +326,15 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         let mut sides = [Side::empty(), Side::empty()];
         let (mut i, mut j) = (0, ids.len());
         while i < j {
-            let b = ids[i].bounds(self.prims);
+            let Some(id) = ids.get(i) else { break };
+            let b = id.bounds(self.prims);
             if left(&b) {
                 sides[0].add(&b);
                 i += 1;
             } else {
                 sides[1].add(&b);
                 j -= 1;
-                ids.swap(i, j);
+                swap_in(ids, i, j);
             }
         }
         sides
@@ -357,6 +384,7 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
     }
 
     fn median<T: Slot<S>>(&self, ids: &mut [T], axis: usize) -> [Side<S>; 2] {
+        let axis = axis.min(2);
         let mid = ids.len() / 2;
         select_nth(ids, mid, |id| (key(&id.bounds(self.prims), axis), id.id()));
         let (left, right) = ids.split_at(mid);
@@ -396,7 +424,8 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         for id in ids.iter() {
             let b = id.bounds(self.prims);
             for (a, axis_bins) in bins.iter_mut().enumerate() {
-                let bin = &mut axis_bins[bin_of(key(&b, a), a)];
+                // `% BINS` is a no-op (bins < nb <= BINS) that shows the compiler the bound.
+                let bin = &mut axis_bins[bin_of(key(&b, a), a) % BINS];
                 bin.0 = bin.0.union(&b);
                 bin.1 += 1;
             }
@@ -407,31 +436,34 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
             if scale[a] == 0.0 {
                 continue;
             }
+            let axis_bins = bins[a].get(..nb).unwrap_or_default();
             let mut right_cost = [0.0f32; BINS];
             let mut right = (empty_box::<S>(), 0u32);
-            for i in (1..nb).rev() {
-                right.0 = right.0.union(&bins[a][i].0);
-                right.1 += bins[a][i].1;
-                right_cost[i] = if right.1 > 0 {
+            for (bin, rc) in axis_bins.iter().zip(right_cost.iter_mut()).skip(1).rev() {
+                right.0 = right.0.union(&bin.0);
+                right.1 += bin.1;
+                *rc = if right.1 > 0 {
                     half_area(&right.0) * right.1 as f32
                 } else {
                     0.0
                 };
             }
             let mut left = (empty_box::<S>(), 0u32);
-            for i in 0..nb - 1 {
-                left.0 = left.0.union(&bins[a][i].0);
-                left.1 += bins[a][i].1;
+            let sweep = axis_bins.iter().zip(right_cost.iter().skip(1));
+            for (i, (bin, rc)) in sweep.take(nb - 1).enumerate() {
+                left.0 = left.0.union(&bin.0);
+                left.1 += bin.1;
                 if left.1 == 0 || left.1 as usize == count {
                     continue;
                 }
-                let cost = half_area(&left.0) * left.1 as f32 + right_cost[i + 1];
+                let cost = half_area(&left.0) * left.1 as f32 + rc;
                 if best.is_none_or(|b| cost < b.0) {
                     best = Some((cost, a, i, left.0.union(&right.0)));
                 }
             }
         }
         let (cost, axis, last_left_bin, parent) = best?;
+        let axis = axis.min(2); // a no-op that shows the compiler the bound
         let parent_area = half_area(&parent);
         if count <= self.max_leaf
             && parent_area * count as f32 <= TRAVERSAL_COST * parent_area + cost

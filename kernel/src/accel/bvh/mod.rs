@@ -156,22 +156,39 @@ impl<'a, S: Scalar, P: Primitive<S>> Bvh<'a, S, P> {
             return Err(BuildError::TooManyPrims { count: prims.len() });
         }
         let (node_count, depth) = build::build(prims, nodes, prim_ids, options)?;
-        let ids = &mut prim_ids[..prims.len()];
+        let available = prim_ids.len();
+        let Some(ids) = prim_ids.get_mut(..prims.len()) else {
+            // Unreachable: `build` checked the size.
+            return Err(BuildError::ArenaTooSmall {
+                arena: crate::error::Arena::PrimIds,
+                needed: prims.len(),
+                available,
+            });
+        };
         // Apply the permutation cycle by cycle: slot j receives the primitive ids[j].
+        // (`ids` is a permutation of `0..n` from the builder, so every `get` succeeds.)
         for start in 0..ids.len() {
-            if ids[start] & MARK != 0 {
+            let (Some(&id), Some(&first)) = (ids.get(start), prims.get(start)) else {
+                break;
+            };
+            if id & MARK != 0 {
                 continue;
             }
-            let first = prims[start];
             let mut j = start;
-            loop {
-                let k = ids[j] as usize;
-                ids[j] |= MARK;
+            while let Some(id) = ids.get_mut(j) {
+                let k = *id as usize;
+                *id |= MARK;
+                let next = if k == start {
+                    Some(first)
+                } else {
+                    prims.get(k).copied()
+                };
+                if let (Some(p), Some(slot)) = (next, prims.get_mut(j)) {
+                    *slot = p;
+                }
                 if k == start {
-                    prims[j] = first;
                     break;
                 }
-                prims[j] = prims[k];
                 j = k;
             }
         }

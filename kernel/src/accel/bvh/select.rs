@@ -1,15 +1,25 @@
 //! In-place, allocation-free, panic-free partitioning of primitive slots.
 
+/// Swaps `v[a]` and `v[b]`; a no-op if either index is out of range. Callers pass proven
+/// indices: the check only lets the compiler drop `swap`'s panic path.
+#[inline(always)]
+pub(super) fn swap_in<T>(v: &mut [T], a: usize, b: usize) {
+    if a < v.len() && b < v.len() {
+        v.swap(a, b);
+    }
+}
+
 /// Reorders `ids` so those with `left(id)` come first; returns how many there are.
 pub(super) fn partition<T: Copy>(ids: &mut [T], mut left: impl FnMut(&T) -> bool) -> usize {
     let mut i = 0;
     let mut j = ids.len();
     while i < j {
-        if left(&ids[i]) {
+        let Some(id) = ids.get(i) else { break };
+        if left(id) {
             i += 1;
         } else {
             j -= 1;
-            ids.swap(i, j);
+            swap_in(ids, i, j);
         }
     }
     i
@@ -30,26 +40,33 @@ pub(super) fn select_nth<T: Copy>(ids: &mut [T], nth: usize, key: impl Fn(&T) ->
     let (mut lo, mut hi) = (0usize, ids.len());
     let mut budget = 2 * (usize::BITS - ids.len().leading_zeros());
     while hi - lo > 1 && nth > lo && nth < hi {
+        let Some(w) = ids.get_mut(lo..hi) else { return };
         if budget == 0 {
-            heapsort(&mut ids[lo..hi], &key);
+            heapsort(w, &key);
             return;
         }
         budget -= 1;
-        // Median of three as pivot, moved to the end.
-        let mid = lo + (hi - lo) / 2;
-        let (a, b, c) = (&ids[lo], &ids[mid], &ids[hi - 1]);
+        // Median of three as pivot, moved to the end (indices relative to `w = ids[lo..hi]`).
+        let (mid, last) = (w.len() / 2, w.len() - 1);
+        let (Some(a), Some(b), Some(c)) = (w.first(), w.get(mid), w.get(last)) else {
+            return;
+        };
         let p = if less(&key, a, b) == less(&key, b, c) {
             mid
         } else if less(&key, b, a) == less(&key, a, c) {
-            lo
+            0
         } else {
-            hi - 1
+            last
         };
-        ids.swap(p, hi - 1);
-        let pivot = ids[hi - 1];
-        let split = lo + partition(&mut ids[lo..hi - 1], |id| less(&key, id, &pivot));
-        ids.swap(split, hi - 1);
-        // ids[lo..split] < pivot = ids[split] < ids[split + 1..hi]
+        swap_in(w, p, last);
+        let Some((pivot, rest)) = w.split_last_mut() else {
+            return;
+        };
+        let pivot = *pivot;
+        let split = partition(rest, |id| less(&key, id, &pivot));
+        swap_in(w, split, last);
+        // w[..split] < pivot = w[split] < w[split + 1..]
+        let split = lo + split;
         if nth <= split {
             hi = split;
         } else {
@@ -59,26 +76,34 @@ pub(super) fn select_nth<T: Copy>(ids: &mut [T], nth: usize, key: impl Fn(&T) ->
 }
 
 fn heapsort<T: Copy>(v: &mut [T], key: &impl Fn(&T) -> (f32, u32)) {
-    let sift = |v: &mut [T], mut root: usize, end: usize| loop {
-        let mut child = 2 * root + 1;
-        if child >= end {
-            break;
+    let sift = |v: &mut [T], mut root: usize, end: usize| {
+        let end = end.min(v.len());
+        loop {
+            let mut child = 2 * root + 1;
+            if child >= end {
+                break;
+            }
+            if let (Some(a), Some(b)) = (v.get(child), v.get(child + 1)) {
+                if child + 1 < end && less(key, a, b) {
+                    child += 1;
+                }
+            }
+            let (Some(r), Some(c)) = (v.get(root), v.get(child)) else {
+                break;
+            };
+            if !less(key, r, c) {
+                break;
+            }
+            swap_in(v, root, child);
+            root = child;
         }
-        if child + 1 < end && less(key, &v[child], &v[child + 1]) {
-            child += 1;
-        }
-        if !less(key, &v[root], &v[child]) {
-            break;
-        }
-        v.swap(root, child);
-        root = child;
     };
     let n = v.len();
     for start in (0..n / 2).rev() {
         sift(v, start, n);
     }
     for end in (1..n).rev() {
-        v.swap(0, end);
+        swap_in(v, 0, end);
         sift(v, 0, end);
     }
 }

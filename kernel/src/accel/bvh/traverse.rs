@@ -92,7 +92,9 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                     break 'walk;
                 }
                 sp -= 1;
-                let (index, t_near) = stack[sp];
+                // `% MAX_DEPTH` is a no-op (pushes stop at MAX_DEPTH entries) that compiles to a
+                // mask and keeps the bounds-check panic out of the loop.
+                let (index, t_near) = stack[sp % MAX_DEPTH];
                 if t_near <= S::widen(best_t) {
                     if let Some(n) = self.nodes.get(index as usize) {
                         node = n;

@@ -88,12 +88,16 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
         let mut next_first = 0usize;
         while sp > 0 {
             sp -= 1;
-            let (index, depth) = stack[sp];
+            let Some(&(index, depth)) = stack.get(sp) else {
+                return Err(InvalidTree::TooDeep { depth: sp });
+            };
             if depth > MAX_DEPTH {
                 return Err(InvalidTree::TooDeep { depth });
             }
             stats.depth = stats.depth.max(depth);
-            let node = &self.nodes[index];
+            let Some(node) = self.nodes.get(index) else {
+                return Err(InvalidTree::BadChild { node: index });
+            };
             if node.is_leaf() {
                 let (first, count) = (node.first as usize, node.count as usize);
                 if first != next_first || count > MAX_LEAF_SIZE as usize || first + count > n {
@@ -102,7 +106,10 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                 next_first = first + count;
                 stats.leaf_count += 1;
                 stats.max_leaf_size = stats.max_leaf_size.max(node.count);
-                for (slot, &id) in (first..).zip(&self.prim_ids[first..first + count]) {
+                let Some(leaf_ids) = self.prim_ids.get(first..first + count) else {
+                    return Err(InvalidTree::BadLeafRange { node: index });
+                };
+                for (slot, &id) in (first..).zip(leaf_ids) {
                     let at = if self.leaf_order { slot } else { id as usize };
                     let Some(p) = self.prims.get(at) else {
                         return Err(InvalidTree::BadPrimIds { prim: id });
@@ -121,13 +128,16 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                 return Err(InvalidTree::BadChild { node: index });
             }
             for child in [l + 1, l] {
-                if !node.bounds().contains(&self.nodes[child].bounds()) {
+                let Some(c) = self.nodes.get(child) else {
+                    return Err(InvalidTree::BadChild { node: index });
+                };
+                if !node.bounds().contains(&c.bounds()) {
                     return Err(InvalidTree::ChildOutsideParent { node: child });
                 }
-                if sp == stack.len() {
+                let Some(slot) = stack.get_mut(sp) else {
                     return Err(InvalidTree::TooDeep { depth: depth + 1 });
-                }
-                stack[sp] = (child, depth + 1);
+                };
+                *slot = (child, depth + 1);
                 sp += 1;
             }
         }
