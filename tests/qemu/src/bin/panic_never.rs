@@ -11,6 +11,7 @@
 use core::hint::black_box;
 use cortex_m_rt::entry;
 use raykernel::bvh::{nodes_needed, BuildOptions};
+use raykernel::spawn::{spawn_ray, spawn_shadow_ray, SpawnScalar};
 use raykernel::{
     Aabb, Accel, Bvh, Linear, Node, Primitive, Ray, Scalar, Sphere, TraversalStats, Triangle,
     Vec3x, I16F16,
@@ -38,6 +39,17 @@ fn queries<S: Scalar, P: Primitive<S>>(bvh: &Bvh<'_, S, P>, prims: &[P], ray: &R
     black_box(linear.intersect_counted(ray, &mut stats));
     black_box(linear.occluded_counted(ray, &mut stats));
     black_box(stats);
+}
+
+/// Secondary rays from a hit: reflection-style and shadow rays.
+fn spawns<S: SpawnScalar>(tri: &Triangle<S>, ray: &Ray<S>) {
+    if let Some(hit) = tri
+        .intersect(ray)
+        .map(|(t, u, v)| raykernel::Hit { t, prim: 0, u, v })
+    {
+        black_box(spawn_ray(ray, &hit, tri, ray.dir()).ok());
+        black_box(spawn_shadow_ray(ray, &hit, tri, black_box([S::ZERO; 3])).ok());
+    }
 }
 
 /// Rays from every constructor, then builds with both build entry points and queries.
@@ -117,6 +129,10 @@ fn main() -> ! {
         black_box(sx.hit_t(r.data(), I16F16::ZERO, I16F16::MAX));
     }
     black_box(x[0].to_f32());
+    if let (Ok(r), Ok(rx)) = (Ray::<f32>::new(v[2], v[0]), Ray::<I16F16>::new(x[2], x[0])) {
+        spawns(&t, &r);
+        spawns(&tx, &rx);
+    }
 
     // I16F16 arithmetic.
     let (a, b) = black_box((I16F16::from_f32(1.5), I16F16::from_raw(-7)));
