@@ -1166,8 +1166,15 @@ fn spawned<S: Mode>(meshes: &[Mesh]) {
                 let (ga, gb) = (S::from_f64(f64::from(a)), S::from_f64(f64::from(b)));
                 let ht = to_f64(S::vec_to_array(ray.origin()));
                 let hp = [0, 1, 2].map(|k| ht[k] + SpawnScalar::to_f64(hit.t) * d[k]);
-                let gp = to_f64(gt.v[0]);
-                let toward = S::array_to_vec(unit(sub(hp, gp)).map(S::from_f64_dir));
+                let gv = gt.v.map(to_f64::<S>);
+                let (af, bf) = (SpawnScalar::to_f64(ga), SpawnScalar::to_f64(gb));
+                let gq = [0, 1, 2]
+                    .map(|k| gv[0][k] + af * (gv[1][k] - gv[0][k]) + bf * (gv[2][k] - gv[0][k]));
+                // Offset the target toward the shading point's *offset* origin: the raw hit
+                // point may lie on an edge shared with the target's triangle, i.e. on its plane.
+                let to_target = S::array_to_vec(unit(sub(gq, hp)).map(S::from_f64_dir));
+                let o_ref = to_f64(offset_origin(&tri, hit.u, hit.v, to_target));
+                let toward = S::array_to_vec(unit(sub(o_ref, gq)).map(S::from_f64_dir));
                 let target = offset_origin(&gt, ga, gb, toward);
                 if let Ok(sr) = spawn_shadow_ray(&ray, &hit, &tri, target) {
                     shadow.rays += 1;
