@@ -31,8 +31,10 @@
 //!
 //! Shadow rays: [`spawn_shadow_ray`] aims at a target point and stops short of it by
 //! [`SHADOW_SHORTEN`] of the distance (and at least one raw unit in fixed point). When the target
-//! lies on a surface, offset it first with [`offset_origin`] toward the shading point, so the
-//! target's own surface lies beyond `t_max` by at least its offset.
+//! lies on a surface, offset it first with [`offset_origin`] toward the shading point's *offset*
+//! origin (`offset_origin` of the shading hit), so the target's own surface lies beyond `t_max`
+//! by at least its offset. Not toward the raw hit point: a hit on an edge shared with the
+//! target's triangle lies on the target's plane, and the side would be a coin toss.
 //!
 //! The stress suite (`kernel/tests/stress.rs`) counts self-hits over millions of spawned rays at
 //! scales 1e-4 to 1e4 and in the fixed-point range; the fuzz target `accel_equivalence` calls
