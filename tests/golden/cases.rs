@@ -264,6 +264,7 @@ fn hash_hit<S: Bits>(h: &mut Fnv, hit: &Option<Hit<S>>) {
 }
 
 /// The bits of every ray's origin, direction and interval as the constructors store them.
+#[inline(never)] // one case's buffers on the stack at a time (the M0 has 16 KB of RAM)
 pub fn hash_rays<S: Bits>() -> Result<u64, Fail> {
     let mut h = Fnv::new();
     for i in 0..RAY_COUNT {
@@ -290,13 +291,21 @@ pub fn hash_queries<S: Bits, A: Accel<S>>(accel: &A) -> Result<u64, Fail> {
     Ok(h.finish())
 }
 
+/// The bits of ray `r`'s closest hit through `a`, and its any-hit answer. Not inlined, so a
+/// caller comparing two accelerators holds one query's stack at a time (the M0 has 16 KB).
+#[inline(never)]
+fn query_bits<S: Bits, A: Accel<S>>(a: &A, r: &Ray<S>) -> (Option<[u32; 4]>, bool) {
+    let hit = a
+        .intersect(r)
+        .map(|h| [h.t.bits(), h.prim, h.u.bits(), h.v.bits()]);
+    (hit, a.occluded(r))
+}
+
 /// Every query through `a` gives the same bits as through `b`.
 pub fn same_queries<S: Bits, A: Accel<S>, B: Accel<S>>(a: &A, b: &B) -> Result<(), Fail> {
     for index in 0..RAY_COUNT {
         let r = ray::<S>(index)?;
-        let (ha, hb) = (a.intersect(&r), b.intersect(&r));
-        let bits = |h: Option<Hit<S>>| h.map(|h| (h.t.bits(), h.prim, h.u.bits(), h.v.bits()));
-        if bits(ha) != bits(hb) || a.occluded(&r) != b.occluded(&r) {
+        if query_bits(a, &r) != query_bits(b, &r) {
             return Err(Fail::Differs { index });
         }
     }
@@ -323,6 +332,7 @@ pub fn hash_tree<S: Bits, P: Primitive<S>>(bvh: &Bvh<'_, S, P>) -> u64 {
 
 /// Builds the icosphere with `builder` (leaves of up to 4), validates it, checks every query
 /// against brute force, and hashes the tree.
+#[inline(never)] // one case's buffers on the stack at a time (the M0 has 16 KB of RAM)
 pub fn tree_case<S: Bits>(builder: BuilderKind) -> Result<u64, Fail> {
     let mut tris = empty_mesh::<S>();
     icosphere(&mut tris)?;
@@ -338,12 +348,14 @@ pub fn tree_case<S: Bits>(builder: BuilderKind) -> Result<u64, Fail> {
     Ok(hash_tree(&bvh))
 }
 
+#[inline(never)] // one case's buffers on the stack at a time (the M0 has 16 KB of RAM)
 fn linear_case<S: Bits>() -> Result<u64, Fail> {
     let mut tris = empty_mesh::<S>();
     icosphere(&mut tris)?;
     hash_queries(&Linear::new(&tris))
 }
 
+#[inline(never)] // one case's buffers on the stack at a time (the M0 has 16 KB of RAM)
 fn spheres_case<S: Bits>() -> Result<u64, Fail> {
     let s = spheres::<S>()?;
     let mut nodes = [Node::<S>::EMPTY; nodes_needed(SPHERE_COUNT)];

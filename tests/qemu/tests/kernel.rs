@@ -305,33 +305,51 @@ fn error_cases<S: Scalar>() {
     defmt::assert!(r(z, x, -1.0, 1.0) == Some(RayError::InvalidInterval));
 }
 
+const PAINT: u32 = 0xa5c3_5a3c;
+
+extern "C" {
+    /// The linker's lowest stack address (cortex-m-rt); the stack grows down towards it.
+    static _stack_end: u32;
+    /// The top of the stack (end of RAM).
+    static _stack_start: u32;
+}
+
+fn stack_bottom() -> usize {
+    core::ptr::addr_of!(_stack_end) as usize
+}
+
+/// Fills the free stack from its end up to `top` with a pattern.
+#[inline(never)]
+fn paint(top: usize) {
+    let mut p = stack_bottom();
+    while p < top {
+        // SAFETY: [stack end, top) is free stack below the caller's frame, word aligned.
+        unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
+        p += 4;
+    }
+}
+
+/// The lowest address at or below `top` whose paint was overwritten.
+#[inline(never)]
+fn lowest_used(top: usize) -> usize {
+    let mut p = stack_bottom();
+    // SAFETY: as in `paint`; reads only.
+    while p < top && unsafe { core::ptr::read_volatile(p as *const u32) } == PAINT {
+        p += 4;
+    }
+    defmt::assert!(p > stack_bottom(), "stack overflowed its painted region");
+    p
+}
+
 /// Fills the free stack below the caller's frame with a pattern, runs `f`, and returns how
 /// many bytes below the painted top `f` used (found by scanning up from the stack's end).
 #[inline(never)]
 fn stack_use(f: impl FnOnce()) -> usize {
-    extern "C" {
-        static _stack_end: u32;
-    }
-    const PAINT: u32 = 0xa5c3_5a3c;
     const GAP: usize = 256; // left alone: this frame and the calls painting makes
-    let sp = cortex_m::register::msp::read() as usize;
-    // `_stack_end` is the linker's lowest stack address; only its address is taken.
-    let bottom = core::ptr::addr_of!(_stack_end) as usize;
-    let top = sp - GAP;
-    let mut p = bottom;
-    while p < top {
-        // SAFETY: [bottom, top) is free stack below our own frame, word aligned.
-        unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
-        p += 4;
-    }
+    let top = cortex_m::register::msp::read() as usize - GAP;
+    paint(top);
     f();
-    let mut p = bottom;
-    // SAFETY: as above; reads only.
-    while p < top && unsafe { core::ptr::read_volatile(p as *const u32) } == PAINT {
-        p += 4;
-    }
-    defmt::assert!(p > bottom, "stack painted region overflowed");
-    top - p
+    top - lowest_used(top)
 }
 
 fn stack_case<S: Bits>() -> (usize, usize) {
@@ -369,6 +387,8 @@ mod tests {
 
     #[test]
     fn golden_table_and_case_list_agree() {
+        // First test: paint the free stack, so the last test can report the peak of the run.
+        super::paint(cortex_m::register::msp::read() as usize - 256);
         defmt::assert_eq!(golden::GOLDEN.len(), cases::NAMES.len());
         for (&(name, _), &case) in golden::GOLDEN.iter().zip(cases::NAMES.iter()) {
             defmt::assert_eq!(name, case);
@@ -476,5 +496,19 @@ mod tests {
         // zero fill is optimised away); builds keep SAH bins and a pending-node stack.
         defmt::assert!(tf > 0 && tx > 0 && bf > tf && bx > tx);
         defmt::assert!(bf.max(bx).max(tf).max(tx) < 8 * 1024, "over 8 KB of stack");
+    }
+    /// Last test: how much of the stack the whole run used (RAM is 16 KB on every machine, as
+    /// on the micro:bit). Fails when less than 512 bytes stay free, before an overflow would.
+    #[test]
+    fn stack_headroom_of_the_whole_run() {
+        let top = core::ptr::addr_of!(super::_stack_start) as usize;
+        let low = super::lowest_used(top);
+        let free = low - super::stack_bottom();
+        defmt::info!(
+            "stack peak of the run: {=usize} B used, {=usize} B free",
+            top - low,
+            free
+        );
+        defmt::assert!(free >= 512, "only {=usize} bytes of stack left", free);
     }
 }
