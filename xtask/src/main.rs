@@ -170,6 +170,26 @@ fn qemu() -> bool {
             if ran { "pass" } else { "FAIL" }
         ));
     }
+    println!("\n=== README embedded example matches tests/qemu/src/bin/readme_example.rs ===");
+    let same = readme_example_matches();
+    println!(
+        "{}",
+        if same {
+            "same code"
+        } else {
+            "README and readme_example.rs differ"
+        }
+    );
+    if same {
+        passed += 1;
+    } else {
+        failed += 1;
+    }
+    summary.push(format!(
+        "{:<34} README example in sync {}",
+        "host",
+        if same { "pass" } else { "FAIL" }
+    ));
     println!("\n=== panic-freedom link check ===");
     let (p, f) = panic_check();
     passed += p;
@@ -186,6 +206,28 @@ fn qemu() -> bool {
     }
     println!("{passed} passed, {failed} failed");
     failed == 0
+}
+
+/// The README's code block under `## Embedded use` equals the lines between the `README`
+/// markers of `readme_example.rs`.
+fn readme_example_matches() -> bool {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let (Ok(readme), Ok(code)) = (
+        std::fs::read_to_string(root.join("README.md")),
+        std::fs::read_to_string(qemu_dir().join("src/bin/readme_example.rs")),
+    ) else {
+        return false;
+    };
+    let block = readme
+        .split_once("## Embedded use")
+        .and_then(|(_, rest)| rest.split_once("```rust,ignore\n"))
+        .and_then(|(_, rest)| rest.split_once("```"))
+        .map(|(b, _)| b.trim());
+    let example = code
+        .split_once("// README begin\n")
+        .and_then(|(_, rest)| rest.split_once("// README end"))
+        .map(|(b, _)| b.trim());
+    block.is_some() && block == example
 }
 
 /// Release-links `panic_never` for every target; returns (passed, failed).
@@ -431,4 +473,26 @@ fn size() -> bool {
         raykernel::bvh::MAX_DEPTH * 8
     );
     ok
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn readme_example_is_in_sync() {
+        assert!(
+            readme_example_matches(),
+            "README's `## Embedded use` block differs from tests/qemu/src/bin/readme_example.rs"
+        );
+    }
+
+    #[test]
+    fn progress_counts_defmt_test_lines() {
+        let out = "(1/3) running `a`...\n(2/3) running `b`...\nERROR panicked\n";
+        assert_eq!(progress(out), (2, 3, false));
+        let out = "(1/2) running `a`...\n(2/2) running `b`...\nall tests passed!\n";
+        assert_eq!(progress(out), (2, 2, true));
+        assert_eq!(progress("(x/2) running"), (0, 0, false));
+    }
 }
