@@ -46,3 +46,9 @@ fn main() -> ! {
 fn exit(code: i32) -> ! {
     semihosting::process::exit(code)
 }
+
+/// A fault exits with 101 instead of spinning until QEMU's timeout.
+#[cortex_m_rt::exception]
+unsafe fn HardFault(_: &cortex_m_rt::ExceptionFrame) -> ! {
+    exit(101)
+}
