@@ -314,15 +314,13 @@ fn panic_sites(elf: &Path) -> Vec<String> {
             continue;
         };
         let out = String::from_utf8_lossy(&out.stdout);
+        // Innermost kernel frame of the inlining chain; call sites without one (core's own
+        // helpers, the probe itself) are lumped together.
         let site = out
             .lines()
             .find(|l| l.contains("/kernel/src/"))
-            .or_else(|| out.lines().next())
-            .unwrap_or("?")
-            .split(" (")
-            .next()
-            .unwrap_or("?")
-            .to_string();
+            .and_then(|l| l.split(" (").next())
+            .map_or_else(|| "(outside kernel/src)".to_string(), str::to_string);
         if !sites.contains(&site) {
             sites.push(site);
         }
