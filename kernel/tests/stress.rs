@@ -625,7 +625,8 @@ fn trace<S: Mode>(a: &Accels<S>, ray: &Ray<S>, index: usize) -> (Option<Hit<S>>,
 // Placements.
 
 /// (scale, shift) pairs for a mesh of extent `e` in mode `S`; `f32` skips placements where the
-/// mesh would span fewer than 2^16 ulps of the shift (it collapses onto a coarse grid).
+/// mesh would be smaller than about 2^-16 of the shift, a few hundred ulps (it
+/// collapses onto a coarse grid).
 fn placements_for<S: Mode>(mesh: &Mesh) -> (Vec<(f64, [f64; 3])>, usize) {
     let (all, skipped) = placements::<S>(mesh.extent);
     if mesh.faces.len() > 10_000 && !full() {
@@ -792,7 +793,7 @@ fn watertight<S: Mode>(meshes: &[Mesh]) {
     }
     if skipped_total > 0 {
         println!(
-            "[{}] skipped {skipped_total} (mesh, scale, shift) placements whose mesh spans fewer than 2^16 ulps of the shift",
+            "[{}] skipped {skipped_total} (mesh, scale, shift) placements whose mesh is smaller than 2^-16 of the shift",
             S::COLUMN
         );
     }
