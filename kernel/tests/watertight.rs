@@ -68,70 +68,11 @@ impl Mesh {
     }
 }
 
-fn normalize(v: [f64; 3]) -> [f64; 3] {
-    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    v.map(|x| x / n)
-}
-
 /// A unit icosahedron subdivided `level` times (midpoints pushed onto the sphere, shared by
 /// index), scaled to `radius`; each vertex's radius is multiplied by `1 + jitter·r`,
 /// `r` uniform in [-1, 1).
 fn icosphere(level: u32, radius: f64, jitter: f32, rng: &mut Rng) -> Mesh {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut verts: Vec<[f64; 3]> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .map(normalize)
-    .to_vec();
-    let mut faces: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..level {
-        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut next = Vec::with_capacity(faces.len() * 4);
-        for &[a, b, c] in &faces {
-            let mut m = |x: u32, y: u32| {
-                *mid.entry((x.min(y), x.max(y))).or_insert_with(|| {
-                    let (p, q) = (verts[x as usize], verts[y as usize]);
-                    verts.push(normalize([0, 1, 2].map(|i| p[i] + q[i])));
-                    verts.len() as u32 - 1
-                })
-            };
-            let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        faces = next;
-    }
+    let (verts, faces) = common::unit_icosphere(level);
     let verts = verts
         .iter()
         .map(|v| {
