@@ -35,6 +35,7 @@
 pub mod accel;
 pub mod error;
 pub mod geom;
+pub mod render;
 pub mod scalar;
 
 pub use accel::bvh::{self, Bvh, Node};

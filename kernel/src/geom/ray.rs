@@ -66,6 +66,17 @@ impl<S: Scalar> Ray<S> {
         })
     }
 
+    /// The same ray (same direction bits and interval) from another origin.
+    ///
+    /// # Errors
+    /// [`RayError::Origin`] for an unusable origin.
+    pub fn moved(&self, origin: [S; 3]) -> Result<Self, RayError> {
+        Ok(Self {
+            data: S::ray_moved(&self.data, origin)?,
+            ..*self
+        })
+    }
+
     /// Origin.
     pub fn origin(&self) -> S::Vec3 {
         S::array_to_vec(S::ray_origin(&self.data))

@@ -222,6 +222,18 @@ impl FixedRay {
         Ok(r)
     }
 
+    fn moved(&self, origin: [I16F16; 3]) -> Result<Self, RayError> {
+        let mut r = *self;
+        for (i, x) in origin.iter().enumerate() {
+            check_raw(x.0).map_err(RayError::Origin)?;
+            let o = x.0 as i64;
+            r.origin[i] = o;
+            r.o_lo[i] = o + 1;
+            r.o_hi[i] = o - 1;
+        }
+        Ok(r)
+    }
+
     #[inline(always)]
     fn rel(&self, v: &[I16F16; 3]) -> [i64; 3] {
         [
@@ -315,6 +327,9 @@ impl Scalar for I16F16 {
         }
         let unit = super::float::unit_dir_f64([dir[0] as f64, dir[1] as f64, dir[2] as f64])?;
         FixedRay::new(o, unit)
+    }
+    fn ray_moved(ray: &FixedRay, origin: [Self; 3]) -> Result<FixedRay, RayError> {
+        ray.moved(origin)
     }
     fn ray_origin(ray: &FixedRay) -> [Self; 3] {
         ray.origin.map(|x| I16F16(x as i32))

@@ -101,19 +101,10 @@ impl FloatRay {
         let d64 = unit_dir_f64([dir[0] as f64, dir[1] as f64, dir[2] as f64])?;
         let dir = [d64[0] as f32, d64[1] as f32, d64[2] as f32];
 
-        let o_max = abs(origin[0]).max_of(abs(origin[1])).max_of(abs(origin[2]));
-        let delta = o_max * MARGIN;
+        let (o_lo, o_hi) = Self::shifted_origins(origin);
         let mut inv = [0.0; 4];
-        let mut o_lo = [0.0; 4];
-        let mut o_hi = [0.0; 4];
         for i in 0..4 {
-            let i3 = i.min(2);
-            inv[i] = 1.0 / dir[i3];
-            // Seen from shifted origins the box grows by `delta` on each side, whichever plane
-            // is near: `lo - (o + delta)` and `hi - (o - delta)`. For a zero component an origin
-            // inside the slab then sees `-inf` and `+inf`, never `0 * inf`.
-            o_lo[i] = shift(origin[i3], delta, true);
-            o_hi[i] = shift(origin[i3], delta, false);
+            inv[i] = 1.0 / dir[i.min(2)];
         }
 
         // Watertight test: kz is the dominant axis; swapping kx/ky keeps the winding.
@@ -140,6 +131,36 @@ impl FloatRay {
             o_hi,
             k: [kx, ky, kz],
             shear,
+        })
+    }
+
+    /// The origins the slab test sees (see the fields' docs), z repeated in lane 3.
+    fn shifted_origins(origin: [f32; 3]) -> ([f32; 4], [f32; 4]) {
+        let o_max = abs(origin[0]).max_of(abs(origin[1])).max_of(abs(origin[2]));
+        let delta = o_max * MARGIN;
+        let mut o_lo = [0.0; 4];
+        let mut o_hi = [0.0; 4];
+        for i in 0..4 {
+            let i3 = i.min(2);
+            // Seen from shifted origins the box grows by `delta` on each side, whichever plane
+            // is near: `lo - (o + delta)` and `hi - (o - delta)`. For a zero component an origin
+            // inside the slab then sees `-inf` and `+inf`, never `0 * inf`.
+            o_lo[i] = shift(origin[i3], delta, true);
+            o_hi[i] = shift(origin[i3], delta, false);
+        }
+        (o_lo, o_hi)
+    }
+
+    fn moved(&self, origin: [f32; 3]) -> Result<Self, RayError> {
+        for &x in &origin {
+            check_coord(x).map_err(RayError::Origin)?;
+        }
+        let (o_lo, o_hi) = Self::shifted_origins(origin);
+        Ok(Self {
+            origin,
+            o_lo,
+            o_hi,
+            ..*self
         })
     }
 
@@ -275,6 +296,9 @@ impl Scalar for f32 {
     }
     fn ray_data_from_f32(origin: [f32; 3], dir: [f32; 3]) -> Result<FloatRay, RayError> {
         FloatRay::new(origin, dir)
+    }
+    fn ray_moved(ray: &FloatRay, origin: [f32; 3]) -> Result<FloatRay, RayError> {
+        ray.moved(origin)
     }
     fn ray_origin(ray: &FloatRay) -> [f32; 3] {
         ray.origin

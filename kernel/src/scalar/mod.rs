@@ -80,6 +80,12 @@ pub trait Scalar:
     /// Prepares a ray from an `f32` origin and direction (for fixed point, the direction keeps
     /// more precision than a Q16.16 vector could carry).
     fn ray_data_from_f32(origin: [f32; 3], dir: [f32; 3]) -> Result<Self::RayData, RayError>;
+    /// The same ray (direction bits unchanged) from another origin: motion blur moves rays
+    /// into a moving object's frame this way.
+    ///
+    /// # Errors
+    /// [`RayError::Origin`] for an unusable origin.
+    fn ray_moved(ray: &Self::RayData, origin: [Self; 3]) -> Result<Self::RayData, RayError>;
     /// The ray origin.
     fn ray_origin(ray: &Self::RayData) -> [Self; 3];
     /// The (unit-length) ray direction, rounded to this mode.

@@ -1,0 +1,641 @@
+//! The renderer's view of the scene's geometry: one accelerator per object, moving objects
+//! behind a swept box, visible area lights, and the rules for leaving a surface.
+//!
+//! Primitive ids are global: the objects' primitives in scene order, then one id per light, so
+//! the closest-hit tie rule (lowest id) orders objects as well as primitives.
+//!
+//! Motion: an object moving by `motion` over the shutter sits at `+ s·motion` at shutter time
+//! `s`. A ray at time `s` meets it by moving the ray into the object's frame: origin minus the
+//! displacement `d(s) = round(s·motion)` (rounded once to the mode; in fixed point the shift is
+//! exact). Before that, the unshifted ray must enter the object's swept box, the union of its
+//! box at `s = 0` and at `s = 1`, padded by `2^-20` of the motion's largest component (in `f32`,
+//! this covers the rounding of the shifted origin; the slab test's own margin covers the
+//! origin's share).
+
+use super::scene::{Object, Shape};
+use super::{AccelChoice, SceneError};
+use crate::accel::bvh::{nodes_needed, Bvh, Node};
+use crate::accel::{Accel, Counters, Linear};
+use crate::error::BuildError;
+use crate::geom::spawn::{self, SpawnScalar, MAX_NUDGES};
+use crate::geom::{closer, Aabb, Hit, Primitive, Ray, Sphere, Triangle};
+use crate::render::scene::{Item, Light, Problem};
+use crate::scalar::Scalar;
+
+/// Spheres leave their surface this many times the triangle rule's offset (the sphere test
+/// solves a quadratic: its roots near the surface carry more rounding than a plane's).
+pub const SPHERE_SPAWN_FACTOR: f64 = 8.0;
+
+/// Most objects a scene may have.
+pub const MAX_OBJECTS: usize = 32;
+/// Most lights a scene may have.
+pub const MAX_LIGHTS: usize = 8;
+
+/// One object's accelerator.
+#[derive(Clone, Copy, Debug)]
+enum Index<'a, S: Scalar, P: Primitive<S>> {
+    Linear(Linear<'a, S, P>),
+    Bvh(Bvh<'a, S, P>),
+}
+
+impl<S: Scalar, P: Primitive<S>> Index<'_, S, P> {
+    #[inline]
+    fn intersect<C: Counters>(&self, ray: &Ray<S>, c: &mut C) -> Option<Hit<S>> {
+        match self {
+            Self::Linear(a) => a.intersect_counted(ray, c),
+            Self::Bvh(a) => a.intersect_counted(ray, c),
+        }
+    }
+    #[inline]
+    fn occluded<C: Counters>(&self, ray: &Ray<S>, c: &mut C) -> bool {
+        match self {
+            Self::Linear(a) => a.occluded_counted(ray, c),
+            Self::Bvh(a) => a.occluded_counted(ray, c),
+        }
+    }
+}
+
+/// Takes the first `n` slots of a buffer, leaving the rest in place.
+fn take<'a, T>(buf: &mut &'a mut [T], n: usize) -> &'a mut [T] {
+    let all = core::mem::take(buf);
+    let n = n.min(all.len());
+    let (mine, rest) = all.split_at_mut(n);
+    *buf = rest;
+    mine
+}
+
+fn build_index<'a, S: Scalar, P: Primitive<S>>(
+    prims: &'a [P],
+    choice: AccelChoice,
+    nodes: &mut &'a mut [Node<S>],
+    ids: &mut &'a mut [u32],
+) -> Result<Index<'a, S, P>, BuildError> {
+    match choice {
+        AccelChoice::Linear => {
+            for (i, p) in prims.iter().enumerate() {
+                p.check()
+                    .map_err(|(vertex, error)| BuildError::BadPrimitive {
+                        prim: i,
+                        vertex,
+                        error,
+                    })?;
+            }
+            Ok(Index::Linear(Linear::new(prims)))
+        }
+        AccelChoice::Bvh(options) => {
+            let n = nodes_needed(prims.len());
+            let node_slots = take(nodes, n);
+            let id_slots = take(ids, prims.len());
+            Ok(Index::Bvh(Bvh::build(
+                prims, node_slots, id_slots, options,
+            )?))
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+enum ShapeIndex<'a, S: Scalar> {
+    Triangles(Index<'a, S, Triangle<S>>),
+    Spheres(Index<'a, S, Sphere<S>>),
+}
+
+/// An object ready for queries.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ObjectGeom<'a, S: Scalar> {
+    index: ShapeIndex<'a, S>,
+    shape: Shape<'a, S>,
+    /// Global id of the object's first primitive.
+    base: u32,
+    /// Material index (checked).
+    pub(crate) material: u32,
+    /// Motion over the shutter, `None` when static.
+    motion: Option<[f32; 3]>,
+    /// World box over the whole shutter interval (moving objects only).
+    swept: Aabb<S>,
+}
+
+/// A light's visible surface.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum LightGeom<S: Scalar> {
+    /// Not visible.
+    Point,
+    /// Two triangles; the front side is the side `edge_u × edge_v` points to.
+    Rect([Triangle<S>; 2], [f32; 3]),
+    /// A sphere.
+    Sphere(Sphere<S>),
+}
+
+/// What a closest hit found.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Surface {
+    /// Object `object`, its primitive `local`.
+    Object { object: usize, local: u32 },
+    /// Light `light`.
+    Light { light: usize },
+}
+
+/// A closest hit over the whole scene.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SceneHit<S: Scalar> {
+    pub(crate) hit: Hit<S>,
+    pub(crate) surface: Surface,
+}
+
+/// Every object and light of a scene, ready for queries at a shutter time.
+#[derive(Clone, Debug)]
+pub(crate) struct Geometry<'a, S: Scalar> {
+    pub(crate) objects: heapless::Vec<ObjectGeom<'a, S>, MAX_OBJECTS>,
+    pub(crate) lights: heapless::Vec<LightGeom<S>, MAX_LIGHTS>,
+    /// Global id of the first light.
+    light_base: u32,
+}
+
+/// Node and id slots a scene needs with [`AccelChoice::Bvh`]: the sums over its objects.
+#[must_use]
+pub fn memory_needed<S: Scalar>(objects: &[Object<'_, S>]) -> (usize, usize) {
+    objects.iter().fold((0, 0), |(n, i), o| {
+        let len = o.shape.len();
+        (n.saturating_add(nodes_needed(len)), i.saturating_add(len))
+    })
+}
+
+/// `+ d` in the mode, rounded once.
+fn shifted<S: SpawnScalar>(p: [S; 3], d: [f64; 3], sign: f64) -> [S; 3] {
+    S::point_from_f64(core::array::from_fn(|k| p[k].to_f64() + sign * d[k]))
+}
+
+impl<'a, S: SpawnScalar> Geometry<'a, S> {
+    /// Builds every object's accelerator into the caller's buffers (BVH: [`memory_needed`]).
+    pub(crate) fn build(
+        objects: &'a [Object<'a, S>],
+        lights: &[Light],
+        choice: AccelChoice,
+        mut nodes: &'a mut [Node<S>],
+        mut ids: &'a mut [u32],
+    ) -> Result<Self, SceneError> {
+        let err = |index, field, problem| SceneError::new(Item::Object, index, field, problem);
+        if objects.len() > MAX_OBJECTS {
+            return Err(err(0, "objects", Problem::TooMany { max: MAX_OBJECTS }));
+        }
+        if lights.len() > MAX_LIGHTS {
+            return Err(SceneError::new(
+                Item::Light,
+                0,
+                "lights",
+                Problem::TooMany { max: MAX_LIGHTS },
+            ));
+        }
+        if let AccelChoice::Bvh(_) = choice {
+            let (n, i) = memory_needed(objects);
+            if nodes.len() < n {
+                let p = Problem::TooSmall {
+                    needed: n,
+                    available: nodes.len(),
+                };
+                return Err(err(0, "nodes", p));
+            }
+            if ids.len() < i {
+                let p = Problem::TooSmall {
+                    needed: i,
+                    available: ids.len(),
+                };
+                return Err(err(0, "prim_ids", p));
+            }
+        }
+        let mut geo = Self {
+            objects: heapless::Vec::new(),
+            lights: heapless::Vec::new(),
+            light_base: 0,
+        };
+        let mut base = 0u32;
+        for (i, o) in objects.iter().enumerate() {
+            let bad = |e| err(i, "shape", Problem::Build(e));
+            if !super::scene::finite3(o.motion) {
+                return Err(err(i, "motion", Problem::NonFinite));
+            }
+            let (index, bounds) = match o.shape {
+                Shape::Triangles(t) => (
+                    ShapeIndex::Triangles(
+                        build_index(t, choice, &mut nodes, &mut ids).map_err(bad)?,
+                    ),
+                    union_bounds(t),
+                ),
+                Shape::Spheres(s) => (
+                    ShapeIndex::Spheres(build_index(s, choice, &mut nodes, &mut ids).map_err(bad)?),
+                    union_bounds(s),
+                ),
+            };
+            let motion = o.moves().then_some(o.motion);
+            let swept = match (motion, bounds) {
+                (Some(m), Some(b)) => swept_box(&b, m),
+                (_, b) => b.unwrap_or(Aabb::new([S::ZERO; 3], [S::ZERO; 3])),
+            };
+            let len = u32::try_from(o.shape.len()).unwrap_or(u32::MAX);
+            let g = ObjectGeom {
+                index,
+                shape: o.shape,
+                base,
+                material: o.material,
+                motion,
+                swept,
+            };
+            // Capacity checked above.
+            let _ = geo.objects.push(g);
+            base = base.checked_add(len).ok_or(err(
+                i,
+                "shape",
+                Problem::Build(BuildError::TooManyPrims {
+                    count: o.shape.len(),
+                }),
+            ))?;
+        }
+        geo.light_base = base;
+        for (i, l) in lights.iter().enumerate() {
+            let _ = geo.lights.push(
+                light_geom(l)
+                    .map_err(|(field, problem)| SceneError::new(Item::Light, i, field, problem))?,
+            );
+        }
+        Ok(geo)
+    }
+
+    /// The ray moved into object `o`'s frame at shutter time `time`, if it is not static.
+    /// `None` if the shifted origin leaves the mode's range (the object is then missed).
+    fn object_ray(o: &ObjectGeom<'_, S>, ray: &Ray<S>, time: f32) -> Option<Ray<S>> {
+        match o.motion {
+            None => Some(*ray),
+            Some(m) => {
+                let d = displacement::<S>(m, time);
+                let origin = shifted(S::vec_to_array(ray.origin()), d, -1.0);
+                ray.moved(origin).ok()
+            }
+        }
+    }
+
+    /// Closest hit at shutter time `time`; ties to the lowest global id.
+    pub(crate) fn intersect<C: Counters>(
+        &self,
+        ray: &Ray<S>,
+        time: f32,
+        c: &mut C,
+    ) -> Option<SceneHit<S>> {
+        let mut best: Option<SceneHit<S>> = None;
+        let mut best_t = ray.t_max();
+        for (i, o) in self.objects.iter().enumerate() {
+            let Ok(r) = ray.with_interval(ray.t_min(), best_t) else {
+                continue;
+            };
+            if o.motion.is_some() {
+                c.node();
+                if o.swept.slab(&r).is_none() {
+                    continue;
+                }
+            }
+            let Some(r) = Self::object_ray(o, &r, time) else {
+                continue;
+            };
+            let h = match &o.index {
+                ShapeIndex::Triangles(a) => a.intersect(&r, c),
+                ShapeIndex::Spheres(a) => a.intersect(&r, c),
+            };
+            if let Some(h) = h {
+                let id = o.base.saturating_add(h.prim);
+                if best.is_none_or(|b| closer(h.t, id, best_t, b.hit.prim)) {
+                    best_t = h.t;
+                    best = Some(SceneHit {
+                        hit: Hit { prim: id, ..h },
+                        surface: Surface::Object {
+                            object: i,
+                            local: h.prim,
+                        },
+                    });
+                }
+            }
+        }
+        for (i, l) in self.lights.iter().enumerate() {
+            let id = self.light_base.saturating_add(i as u32);
+            let t = match l {
+                LightGeom::Point => None,
+                LightGeom::Rect(tris, _) => {
+                    let (t0, t1) = (
+                        tris[0].hit_t(ray.data(), ray.t_min(), best_t),
+                        tris[1].hit_t(ray.data(), ray.t_min(), best_t),
+                    );
+                    match (t0, t1) {
+                        (Some(a), Some(b)) => Some(if b < a { b } else { a }),
+                        (a, b) => a.or(b),
+                    }
+                }
+                LightGeom::Sphere(s) => s.hit_t(ray.data(), ray.t_min(), best_t),
+            };
+            if let Some(t) = t {
+                if best.is_none_or(|b| closer(t, id, best_t, b.hit.prim)) {
+                    best_t = t;
+                    best = Some(SceneHit {
+                        hit: Hit {
+                            t,
+                            prim: id,
+                            u: S::ZERO,
+                            v: S::ZERO,
+                        },
+                        surface: Surface::Light { light: i },
+                    });
+                }
+            }
+        }
+        best
+    }
+
+    /// Any object hit in the ray's interval at shutter time `time` (lights cast no shadow).
+    pub(crate) fn occluded<C: Counters>(&self, ray: &Ray<S>, time: f32, c: &mut C) -> bool {
+        self.objects.iter().any(|o| {
+            if o.motion.is_some() {
+                c.node();
+                if o.swept.slab(ray).is_none() {
+                    return false;
+                }
+            }
+            Self::object_ray(o, ray, time).is_some_and(|r| match &o.index {
+                ShapeIndex::Triangles(a) => a.occluded(&r, c),
+                ShapeIndex::Spheres(a) => a.occluded(&r, c),
+            })
+        })
+    }
+
+    /// The world position, unit geometric normal (not yet facing the ray) of a hit, and the
+    /// origin for leaving the surface towards `toward` (any length, `f32`).
+    pub(crate) fn surface_point(
+        &self,
+        ray: &Ray<S>,
+        h: &SceneHit<S>,
+        time: f32,
+    ) -> Option<SurfacePoint<'_, S>> {
+        let Surface::Object { object, local } = h.surface else {
+            return None;
+        };
+        let o = self.objects.get(object)?;
+        let d = o.motion.map_or([0.0; 3], |m| displacement::<S>(m, time));
+        match o.shape {
+            Shape::Triangles(t) => {
+                let tri = t.get(local as usize)?;
+                let v = tri.v.map(|p| p.map(S::to_f64));
+                let (u, w) = (h.hit.u.to_f64(), h.hit.v.to_f64());
+                let p: [f64; 3] = core::array::from_fn(|k| {
+                    v[0][k] + u * (v[1][k] - v[0][k]) + w * (v[2][k] - v[0][k]) + d[k]
+                });
+                let e1 = sub(&v[1], &v[0]);
+                let e2 = sub(&v[2], &v[0]);
+                let n = unit64(cross(&e1, &e2))
+                    .unwrap_or_else(|| S::ray_dir(ray.data()).map(|x| -x.to_f64()));
+                Some(SurfacePoint {
+                    position: p,
+                    normal: n.map(|x| x as f32),
+                    prim: Prim::Triangle(tri, h.hit.u, h.hit.v),
+                    shift: d,
+                })
+            }
+            Shape::Spheres(s) => {
+                let sp = s.get(local as usize)?;
+                let c = sp.center.map(S::to_f64);
+                // The hit point from the ray in the object's frame, then shifted back.
+                let o3 = S::vec_to_array(ray.origin()).map(S::to_f64);
+                let dir = S::ray_dir(ray.data()).map(S::to_f64);
+                let t = h.hit.t.to_f64();
+                let q: [f64; 3] = core::array::from_fn(|k| o3[k] - d[k] + t * dir[k]);
+                let n = unit64(sub(&q, &c)).unwrap_or(dir.map(|x| -x));
+                let r = sp.radius.to_f64();
+                // The point on the sphere along the normal: the offset is taken from there.
+                let p: [f64; 3] = core::array::from_fn(|k| c[k] + r * n[k] + d[k]);
+                Some(SurfacePoint {
+                    position: p,
+                    normal: n.map(|x| x as f32),
+                    prim: Prim::Sphere(sp),
+                    shift: d,
+                })
+            }
+        }
+    }
+}
+
+/// `round(time·motion)` in the mode, as `f64` (exact).
+fn displacement<S: SpawnScalar>(m: [f32; 3], time: f32) -> [f64; 3] {
+    let d = S::point_from_f64(m.map(|x| f64::from(x) * f64::from(time)));
+    d.map(S::to_f64)
+}
+
+/// The primitive a surface point lies on (in its object's frame at shutter open).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Prim<'a, S: Scalar> {
+    Triangle(&'a Triangle<S>, S, S),
+    Sphere(&'a Sphere<S>),
+}
+
+/// A point on a surface, and how to leave it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SurfacePoint<'a, S: Scalar> {
+    /// World position (`f64`).
+    pub(crate) position: [f64; 3],
+    /// Unit geometric normal (triangles: `(v1−v0)×(v2−v0)`; spheres: outward).
+    pub(crate) normal: [f32; 3],
+    prim: Prim<'a, S>,
+    /// The object's displacement at the ray's time (zero when static).
+    shift: [f64; 3],
+}
+
+impl<S: SpawnScalar> SurfacePoint<'_, S> {
+    /// An origin for a ray leaving the surface towards `toward` (any length), off the surface
+    /// on `toward`'s side by the spawn rule of [`crate::spawn`], checked in the object's frame
+    /// after the motion shift (so the object's own test sees it on the right side).
+    pub(crate) fn spawn_origin(&self, toward: [f32; 3]) -> [S; 3] {
+        // Scale so fixed point keeps the direction's precision (a power of two: exact in f32).
+        let dir_s = S::array_to_vec(toward.map(|x| S::from_f32_saturating(x * 1024.0)));
+        match self.prim {
+            Prim::Triangle(tri, u, v) => {
+                let local = spawn::offset_origin(tri, u, v, dir_s);
+                let want = S::side(&tri.v, &local);
+                let mut world = shifted(local, self.shift, 1.0);
+                if self.shift == [0.0; 3] || want == 0 {
+                    return world;
+                }
+                let n = self.normal;
+                let axis = dominant(n);
+                let up = (n[axis] > 0.0) == (want > 0);
+                for _ in 0..MAX_NUDGES {
+                    if S::side(&tri.v, &shifted(world, self.shift, -1.0)) == want {
+                        break;
+                    }
+                    world[axis] = S::step(world[axis], up);
+                }
+                world
+            }
+            Prim::Sphere(sp) => {
+                let n = self.normal.map(f64::from);
+                let t = toward.map(f64::from);
+                let outside = n[0] * t[0] + n[1] * t[1] + n[2] * t[2] >= 0.0;
+                let c = sp.center.map(S::to_f64);
+                let r = sp.radius.to_f64();
+                let m = c.iter().fold(r, |m, x| libm::fmax(m, libm::fabs(*x) + r));
+                let delta = SPHERE_SPAWN_FACTOR * S::offset(m);
+                let s = if outside { 1.0 } else { -1.0 };
+                let local: [f64; 3] = core::array::from_fn(|k| c[k] + (r + s * delta) * n[k]);
+                let mut world = shifted(S::point_from_f64(local), self.shift, 1.0);
+                let axis = dominant(self.normal);
+                let up = (n[axis] > 0.0) == outside;
+                for _ in 0..MAX_NUDGES {
+                    let q = shifted(world, self.shift, -1.0).map(S::to_f64);
+                    let dq = sub(&q, &c);
+                    let dist2 = dq[0] * dq[0] + dq[1] * dq[1] + dq[2] * dq[2];
+                    if (dist2 > r * r) == outside && dist2 != r * r {
+                        break;
+                    }
+                    world[axis] = S::step(world[axis], up);
+                }
+                world
+            }
+        }
+    }
+}
+
+fn dominant(n: [f32; 3]) -> usize {
+    let a = n.map(libm::fabsf);
+    if a[0] >= a[1] && a[0] >= a[2] {
+        0
+    } else if a[1] >= a[2] {
+        1
+    } else {
+        2
+    }
+}
+
+fn union_bounds<S: Scalar, P: Primitive<S>>(prims: &[P]) -> Option<Aabb<S>> {
+    let mut it = prims.iter();
+    let first = it.next()?.bounds();
+    Some(it.fold(first, |b, p| b.union(&p.bounds())))
+}
+
+/// The box over the whole shutter, padded as the module docs state.
+fn swept_box<S: SpawnScalar>(b: &Aabb<S>, m: [f32; 3]) -> Aabb<S> {
+    let d = displacement::<S>(m, 1.0);
+    let pad = m
+        .iter()
+        .fold(0.0f64, |a, x| libm::fmax(a, libm::fabs(f64::from(*x))))
+        / 1_048_576.0;
+    let lo: [f64; 3] = core::array::from_fn(|k| {
+        let x = b.lo[k].to_f64();
+        libm::fmin(x, x + d[k]) - pad
+    });
+    let hi: [f64; 3] = core::array::from_fn(|k| {
+        let x = b.hi[k].to_f64();
+        libm::fmax(x, x + d[k]) + pad
+    });
+    // Round outward: one unit past the nearest value.
+    let lo = S::point_from_f64(lo).map(|x| S::step(x, false));
+    let hi = S::point_from_f64(hi).map(|x| S::step(x, true));
+    let (lo, hi) = S::pad_bounds(lo, hi);
+    Aabb::new(lo, hi)
+}
+
+fn light_geom<S: Scalar>(l: &Light) -> Result<LightGeom<S>, (&'static str, Problem)> {
+    let pt = |p: [f32; 3], field| -> Result<[S; 3], (&'static str, Problem)> {
+        let mut out = [S::ZERO; 3];
+        for k in 0..3 {
+            out[k] = S::coord_from_f32(p[k]).map_err(|e| (field, point_problem(e)))?;
+        }
+        Ok(out)
+    };
+    match *l {
+        Light::Point {
+            position,
+            intensity,
+        } => {
+            pt(position, "position")?;
+            super::scene::check_rgb(intensity, false).map_err(|p| ("intensity", p))?;
+            Ok(LightGeom::Point)
+        }
+        Light::Rect {
+            corner,
+            edge_u,
+            edge_v,
+            radiance,
+        } => {
+            super::scene::check_rgb(radiance, false).map_err(|p| ("radiance", p))?;
+            if !super::scene::finite3(edge_u) {
+                return Err(("edge_u", Problem::NonFinite));
+            }
+            if !super::scene::finite3(edge_v) {
+                return Err(("edge_v", Problem::NonFinite));
+            }
+            let n = cross(&edge_u.map(f64::from), &edge_v.map(f64::from));
+            let Some(n) = unit64(n) else {
+                return Err(("edge_v", Problem::ZeroArea));
+            };
+            let add = |a: [f32; 3], b: [f32; 3]| core::array::from_fn(|k| a[k] + b[k]);
+            let a = pt(corner, "corner")?;
+            let b = pt(add(corner, edge_u), "edge_u")?;
+            let c = pt(add(add(corner, edge_u), edge_v), "edge_v")?;
+            let d = pt(add(corner, edge_v), "edge_v")?;
+            Ok(LightGeom::Rect(
+                [Triangle { v: [a, b, c] }, Triangle { v: [a, c, d] }],
+                n.map(|x| x as f32),
+            ))
+        }
+        Light::Sphere {
+            center,
+            radius,
+            radiance,
+        } => {
+            super::scene::check_rgb(radiance, false).map_err(|p| ("radiance", p))?;
+            if !radius.is_finite() {
+                return Err(("radius", Problem::NonFinite));
+            }
+            if radius <= 0.0 {
+                return Err(("radius", Problem::NotPositive));
+            }
+            let c = pt(center, "center")?;
+            let r = S::coord_from_f32(radius).map_err(|e| ("radius", point_problem(e)))?;
+            let s = Sphere {
+                center: c,
+                radius: r,
+            };
+            s.check().map_err(|(_, e)| ("radius", point_problem(e)))?;
+            Ok(LightGeom::Sphere(s))
+        }
+    }
+}
+
+pub(crate) fn point_problem(e: crate::error::PointError) -> Problem {
+    match e {
+        crate::error::PointError::NonFinite => Problem::NonFinite,
+        crate::error::PointError::OutOfRange { limit } => Problem::OutOfRange {
+            min: -limit,
+            max: limit,
+        },
+        crate::error::PointError::NegativeRadius => Problem::Negative,
+    }
+}
+
+pub(crate) fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+pub(crate) fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// `v / |v|`, scaled first so tiny and huge vectors normalise; `None` for zero or non-finite.
+pub(crate) fn unit64(v: [f64; 3]) -> Option<[f64; 3]> {
+    let m = libm::fmax(
+        libm::fabs(v[0]),
+        libm::fmax(libm::fabs(v[1]), libm::fabs(v[2])),
+    );
+    if !(m > 0.0 && m.is_finite()) {
+        return None;
+    }
+    let s = v.map(|x| x / m);
+    let l = libm::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    Some(s.map(|x| x / l))
+}

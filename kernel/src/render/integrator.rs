@@ -1,0 +1,265 @@
+//! The bounce loop: camera ray, closest hit, emission, direct light at diffuse surfaces,
+//! reflection rays at mirror and glossy ones. Iterative; each step does only what the render
+//! plan says the scene needs.
+
+use super::geometry::{Surface, SurfacePoint};
+use super::sampling::{phong_lobe, tent, to_world, uniform_cone, SampleStream};
+use super::scene::{Filter, Light, Material};
+use super::{RenderPlan, RenderStats, Renderer};
+use crate::accel::NoStats;
+use crate::geom::spawn::{shadow_t_max, SpawnScalar};
+use crate::geom::Ray;
+use core::f32::consts::FRAC_1_PI;
+use glam::Vec3;
+
+/// Radiance of one pixel sample.
+#[inline]
+pub(crate) fn sample_radiance<S: SpawnScalar>(
+    r: &Renderer<'_, S>,
+    x: u32,
+    y: u32,
+    stream: &mut SampleStream,
+    stats: &mut RenderStats,
+) -> Vec3 {
+    let plan: &RenderPlan = &r.plan;
+    let (px, py) = if plan.pixel_centre {
+        (0.5, 0.5)
+    } else {
+        let (a, b) = stream.next_2d();
+        match plan.filter {
+            Filter::Box => (a, b),
+            Filter::Tent => (0.5 + tent(a), 0.5 + tent(b)),
+        }
+    };
+    let lens = plan.lens.then(|| stream.next_2d());
+    let time = if plan.motion { stream.next_2d().0 } else { 0.0 };
+    let (o, d) = r.camera.ray(x as f32 + px, y as f32 + py, lens);
+    stats.camera_rays += 1;
+    let Ok(mut ray) = Ray::<S>::from_f32(o.to_array(), d.to_array(), 0.0, f32::INFINITY) else {
+        return Vec3::ZERO;
+    };
+    let mut dir = d.normalize_or_zero();
+    let mut throughput = Vec3::ONE;
+    let mut radiance = Vec3::ZERO;
+    let mut depth = 0u32;
+    loop {
+        let Some(hit) = r.geometry.intersect(&ray, time, &mut NoStats) else {
+            radiance += throughput * Vec3::from_array(r.background);
+            break;
+        };
+        let object = match hit.surface {
+            Surface::Light { light } => {
+                radiance += throughput * light_seen(r, light, dir);
+                break;
+            }
+            Surface::Object { object, .. } => object,
+        };
+        let Some(sp) = r.geometry.surface_point(&ray, &hit, time) else {
+            break;
+        };
+        let material = r
+            .geometry
+            .objects
+            .get(object)
+            .and_then(|o| r.materials.get(o.material as usize));
+        let n = Vec3::from_array(sp.normal);
+        // Two-sided surfaces: shade with the normal facing the incoming ray.
+        let nf = if n.dot(dir) > 0.0 { -n } else { n };
+        match material {
+            None => break,
+            Some(Material::Emissive { radiance: e }) => {
+                radiance += throughput * Vec3::from_array(*e);
+                break;
+            }
+            Some(Material::Diffuse { albedo }) => {
+                let e = direct_light(r, &sp, nf, time, stream, stats);
+                radiance += throughput * Vec3::from_array(*albedo) * (e * FRAC_1_PI);
+                break;
+            }
+            Some(Material::Mirror { reflectance }) => {
+                if depth >= plan.max_depth {
+                    break;
+                }
+                throughput *= Vec3::from_array(*reflectance);
+                dir = reflect(dir, nf);
+            }
+            Some(Material::Glossy {
+                reflectance,
+                exponent,
+            }) => {
+                if depth >= plan.max_depth {
+                    break;
+                }
+                let (a, b) = stream.next_2d();
+                let lobe = to_world(phong_lobe(a, b, *exponent), reflect(dir, nf));
+                if lobe.dot(nf) <= 0.0 {
+                    break;
+                }
+                throughput *= Vec3::from_array(*reflectance);
+                dir = lobe.normalize_or_zero();
+            }
+        }
+        depth += 1;
+        if throughput == Vec3::ZERO {
+            break;
+        }
+        let origin = sp.spawn_origin(dir.to_array());
+        stats.reflection_rays += 1;
+        let Ok(next) = Ray::<S>::new(S::array_to_vec(origin), dir_in_mode::<S>(dir)) else {
+            break;
+        };
+        ray = next;
+    }
+    radiance
+}
+
+/// A direction in the mode, scaled by 1024 so fixed point keeps its precision (the ray
+/// constructor normalises; the scale is a power of two, exact in `f32`).
+pub(crate) fn dir_in_mode<S: SpawnScalar>(d: Vec3) -> S::Vec3 {
+    S::array_to_vec(d.to_array().map(|x| S::from_f32_saturating(x * 1024.0)))
+}
+
+fn reflect(d: Vec3, n: Vec3) -> Vec3 {
+    d - n * (2.0 * d.dot(n))
+}
+
+/// Radiance a camera or reflection ray sees on light `i`'s surface.
+fn light_seen<S: SpawnScalar>(r: &Renderer<'_, S>, i: usize, dir: Vec3) -> Vec3 {
+    match (r.lights.get(i), r.geometry.lights.get(i)) {
+        (Some(Light::Rect { radiance, .. }), Some(super::geometry::LightGeom::Rect(_, n))) => {
+            if dir.dot(Vec3::from_array(*n)) < 0.0 {
+                Vec3::from_array(*radiance)
+            } else {
+                Vec3::ZERO
+            }
+        }
+        (Some(Light::Sphere { radiance, .. }), _) => Vec3::from_array(*radiance),
+        _ => Vec3::ZERO,
+    }
+}
+
+/// Irradiance-like sum `Σ L·cos θ / pdf` over every light at a diffuse point (the caller
+/// multiplies by `albedo / π`), one sample per area light, each tested by a shadow ray.
+fn direct_light<S: SpawnScalar>(
+    r: &Renderer<'_, S>,
+    sp: &SurfacePoint<'_, S>,
+    nf: Vec3,
+    time: f32,
+    stream: &mut SampleStream,
+    stats: &mut RenderStats,
+) -> Vec3 {
+    let p = sp.position;
+    let pf = Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
+    let mut sum = Vec3::ZERO;
+    for light in r.lights {
+        // Each arm gives the target point, the unoccluded contribution, or nothing.
+        let (target, contribution) = match *light {
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                let to = Vec3::from_array(position) - pf;
+                let d2 = to.length_squared();
+                let cos = nf.dot(to) / libm::sqrtf(d2);
+                if !(cos > 0.0 && d2 > 0.0) {
+                    continue;
+                }
+                (position, Vec3::from_array(intensity) * (cos / d2))
+            }
+            Light::Rect {
+                corner,
+                edge_u,
+                edge_v,
+                radiance,
+            } => {
+                let (a, b) = stream.next_2d();
+                let (eu, ev) = (Vec3::from_array(edge_u), Vec3::from_array(edge_v));
+                let y = Vec3::from_array(corner) + eu * a + ev * b;
+                let to = y - pf;
+                let d2 = to.length_squared();
+                let dist = libm::sqrtf(d2);
+                let cross = eu.cross(ev);
+                let area = cross.length();
+                let cos = nf.dot(to) / dist;
+                let cos_l = -cross.dot(to) / (area * dist);
+                if !(cos > 0.0 && cos_l > 0.0 && d2 > 0.0) {
+                    continue;
+                }
+                (
+                    y.to_array(),
+                    Vec3::from_array(radiance) * (cos * cos_l * area / d2),
+                )
+            }
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } => {
+                let (a, b) = stream.next_2d();
+                let to_c = Vec3::from_array(center) - pf;
+                let dc2 = to_c.length_squared();
+                let r2 = radius * radius;
+                if dc2 <= r2 || dc2.is_nan() {
+                    continue;
+                }
+                let dc = libm::sqrtf(dc2);
+                let axis = to_c / dc;
+                let cos_max = libm::sqrtf(1.0 - r2 / dc2);
+                let wi = to_world(uniform_cone(a, b, cos_max), axis);
+                let cos = nf.dot(wi);
+                if cos <= 0.0 || cos.is_nan() {
+                    continue;
+                }
+                // Nearest root of |p + t·wi − c| = r (the cone guarantees one, up to rounding).
+                let b_half = wi.dot(to_c);
+                let disc = b_half * b_half - (dc2 - r2);
+                let t = b_half - libm::sqrtf(if disc > 0.0 { disc } else { 0.0 });
+                let solid_angle = 2.0 * core::f32::consts::PI * (1.0 - cos_max);
+                (
+                    (pf + wi * t).to_array(),
+                    Vec3::from_array(radiance) * (cos * solid_angle),
+                )
+            }
+        };
+        if contribution == Vec3::ZERO {
+            continue;
+        }
+        stats.shadow_rays += 1;
+        if visible(r, sp, target, time) {
+            sum += contribution;
+        }
+    }
+    sum
+}
+
+/// True if nothing blocks the segment from the surface point to `target`.
+fn visible<S: SpawnScalar>(
+    r: &Renderer<'_, S>,
+    sp: &SurfacePoint<'_, S>,
+    target: [f32; 3],
+    time: f32,
+) -> bool {
+    let p = sp.position;
+    let toward = [
+        (f64::from(target[0]) - p[0]) as f32,
+        (f64::from(target[1]) - p[1]) as f32,
+        (f64::from(target[2]) - p[2]) as f32,
+    ];
+    let origin = sp.spawn_origin(toward);
+    let o = origin.map(S::to_f64);
+    let d = [
+        f64::from(target[0]) - o[0],
+        f64::from(target[1]) - o[1],
+        f64::from(target[2]) - o[2],
+    ];
+    let len = libm::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    let dir = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32).normalize_or_zero();
+    let Ok(ray) = Ray::<S>::new(S::array_to_vec(origin), dir_in_mode::<S>(dir)) else {
+        // Origin and target coincide (or the origin left the range): count as lit.
+        return true;
+    };
+    let Ok(ray) = ray.with_interval(S::ZERO, shadow_t_max::<S>(len)) else {
+        return true;
+    };
+    !r.geometry.occluded(&ray, time, &mut NoStats)
+}

@@ -1,0 +1,412 @@
+//! A distribution ray tracer (Cook, Porter, Carpenter 1984) on the kernel's queries: many rays
+//! per pixel, each sampling a point on the pixel, the lens, the lights, the reflection lobe and
+//! the shutter interval. `no_std`, no allocation, both number modes.
+//!
+//! - The caller owns the scene ([`Scene`]: objects, materials, lights, camera) and the memory
+//!   (BVH nodes and ids, sized by [`memory_needed`]; the framebuffer).
+//! - [`Renderer::new`] checks the scene (typed [`SceneError`]s), builds one accelerator per
+//!   object and derives the [`RenderPlan`]: the features the scene and settings need. Features
+//!   the plan leaves out cost a branch, not work.
+//! - [`Renderer::render_tile`] renders any rectangle of pixels. Every random value is a pure
+//!   function of (pixel, sample, dimension, seed), so tiles can be rendered in any order, on
+//!   any thread or core, and the image is the same bits.
+//!
+//! Geometry (rays, boxes, primitive tests, spawn offsets) runs in the mode `S`; shading runs in
+//! `f32` in both modes (correctly rounded IEEE operations and `libm`, hence the same bits on
+//! every platform). The time dimension, the lens, the pixel jitter and light samples use
+//! separate dimension pairs of the sample stream ([`sampling`]).
+
+mod camera;
+mod geometry;
+mod integrator;
+pub mod sampling;
+mod scene;
+pub mod scenes;
+
+pub use geometry::{memory_needed, MAX_LIGHTS, MAX_OBJECTS, SPHERE_SPAWN_FACTOR};
+pub use sampling::SamplerKind;
+pub use scene::{
+    Camera, Filter, Item, Light, Material, Object, Problem, Rgb, Scene, SceneError, Settings, Shape,
+};
+
+use crate::accel::bvh::{BuildOptions, Node};
+use crate::geom::spawn::SpawnScalar;
+use camera::CameraFrame;
+use core::fmt;
+use geometry::Geometry;
+use glam::Vec3;
+use sampling::SampleStream;
+
+/// Which accelerator every object is built into.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AccelChoice {
+    /// Brute force (no memory needed): the reference.
+    Linear,
+    /// A BVH per object, built with these options into the caller's node and id buffers.
+    Bvh(BuildOptions),
+}
+
+impl Default for AccelChoice {
+    fn default() -> Self {
+        Self::Bvh(BuildOptions::default())
+    }
+}
+
+/// What a render will do, derived once from the scene and settings. Features marked `false`
+/// are skipped entirely (no samples drawn, no rays cast).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderPlan {
+    /// Samples per pixel.
+    pub spp: u32,
+    /// One sample per pixel: it goes through the pixel centre (no jitter, no filter).
+    pub pixel_centre: bool,
+    /// Sample placement (irrelevant when `pixel_centre` and nothing else samples).
+    pub sampler: SamplerKind,
+    /// Pixel filter (when not `pixel_centre`).
+    pub filter: Filter,
+    /// Depth of field: the aperture is open, so camera rays sample the lens.
+    pub lens: bool,
+    /// Motion blur: some object moves, so rays carry a shutter time.
+    pub motion: bool,
+    /// Point lights (one shadow ray each per diffuse hit).
+    pub point_lights: u32,
+    /// Area lights (one sample and shadow ray each per diffuse hit: soft shadows).
+    pub area_lights: u32,
+    /// Some object is mirror or glossy: reflection rays are traced.
+    pub reflections: bool,
+    /// Some object is glossy: reflection rays sample a lobe.
+    pub glossy: bool,
+    /// Most reflection bounces (0 without reflecting materials).
+    pub max_depth: u32,
+}
+
+impl RenderPlan {
+    fn derive<S: SpawnScalar>(scene: &Scene<'_, S>, settings: &Settings) -> Self {
+        let used = |f: fn(&Material) -> bool| {
+            scene
+                .objects
+                .iter()
+                .any(|o| scene.materials.get(o.material as usize).is_some_and(f))
+        };
+        let reflections = used(Material::reflects) && settings.max_depth > 0;
+        let count = |area: bool| scene.lights.iter().filter(|l| l.is_area() == area).count() as u32;
+        Self {
+            spp: settings.spp,
+            pixel_centre: settings.spp == 1,
+            sampler: settings.sampler,
+            filter: settings.filter,
+            lens: scene.camera.aperture_radius > 0.0,
+            motion: scene
+                .objects
+                .iter()
+                .any(|o| o.moves() && !o.shape.is_empty()),
+            point_lights: count(false),
+            area_lights: count(true),
+            reflections,
+            glossy: reflections && used(|m| matches!(m, Material::Glossy { .. })),
+            max_depth: if reflections { settings.max_depth } else { 0 },
+        }
+    }
+}
+
+impl fmt::Display for RenderPlan {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let on = |b: bool| if b { "on" } else { "off" };
+        if self.pixel_centre {
+            write!(f, "anti-aliasing off (1 spp at pixel centres)")?;
+        } else {
+            write!(
+                f,
+                "anti-aliasing on ({} spp, {}, {} filter)",
+                self.spp,
+                self.sampler.name(),
+                self.filter.name()
+            )?;
+        }
+        write!(
+            f,
+            "; depth of field {}; motion blur {}; lights: {} point, {} area (soft shadows {}); \
+             reflections {} (glossy {}, max depth {})",
+            on(self.lens),
+            on(self.motion),
+            self.point_lights,
+            self.area_lights,
+            on(self.area_lights > 0),
+            on(self.reflections),
+            on(self.glossy),
+            self.max_depth
+        )
+    }
+}
+
+/// A rectangle of pixels: columns `x..x + width`, rows `y..y + height`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tile {
+    /// First column.
+    pub x: u32,
+    /// First row (0 is the top).
+    pub y: u32,
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+}
+
+/// Rays a render cast.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RenderStats {
+    /// Camera rays (one per pixel sample).
+    pub camera_rays: u64,
+    /// Shadow rays (any-hit).
+    pub shadow_rays: u64,
+    /// Reflection rays.
+    pub reflection_rays: u64,
+}
+
+impl RenderStats {
+    /// Every ray.
+    #[must_use]
+    pub const fn rays(&self) -> u64 {
+        self.camera_rays + self.shadow_rays + self.reflection_rays
+    }
+    /// Sum of two counts.
+    #[must_use]
+    pub const fn add(self, o: Self) -> Self {
+        Self {
+            camera_rays: self.camera_rays + o.camera_rays,
+            shadow_rays: self.shadow_rays + o.shadow_rays,
+            reflection_rays: self.reflection_rays + o.reflection_rays,
+        }
+    }
+}
+
+/// A checked scene with its accelerators built, ready to render tiles.
+#[derive(Clone, Debug)]
+pub struct Renderer<'a, S: SpawnScalar> {
+    geometry: Geometry<'a, S>,
+    materials: &'a [Material],
+    lights: &'a [Light],
+    background: Rgb,
+    camera: CameraFrame,
+    settings: Settings,
+    plan: RenderPlan,
+}
+
+impl<'a, S: SpawnScalar> Renderer<'a, S> {
+    /// Checks the scene and settings, builds the accelerators into `nodes` and `prim_ids`
+    /// (for [`AccelChoice::Bvh`]: at least [`memory_needed`] slots; unused for `Linear`) and
+    /// derives the plan.
+    ///
+    /// # Errors
+    /// A [`SceneError`] naming the item, its index, the field and the problem: bad settings,
+    /// camera, material values or indices, light values, too many objects or lights, buffers
+    /// too small, or a primitive the accelerator rejects (non-finite, out of range).
+    pub fn new(
+        scene: &Scene<'a, S>,
+        settings: Settings,
+        accel: AccelChoice,
+        nodes: &'a mut [Node<S>],
+        prim_ids: &'a mut [u32],
+    ) -> Result<Self, SceneError> {
+        check_settings(&settings)?;
+        check_materials(scene)?;
+        let camera = CameraFrame::new(&scene.camera, settings.width, settings.height)?;
+        scene::check_rgb(scene.background, false)
+            .map_err(|p| SceneError::new(Item::Settings, 0, "background", p))?;
+        let geometry = Geometry::build(scene.objects, scene.lights, accel, nodes, prim_ids)?;
+        Ok(Self {
+            geometry,
+            materials: scene.materials,
+            lights: scene.lights,
+            background: scene.background,
+            camera,
+            settings,
+            plan: RenderPlan::derive(scene, &settings),
+        })
+    }
+
+    /// The plan derived from the scene and settings.
+    #[must_use]
+    pub const fn plan(&self) -> &RenderPlan {
+        &self.plan
+    }
+
+    /// The settings.
+    #[must_use]
+    pub const fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Mean linear radiance of pixel `(x, y)` over its samples (no bounds check: pixels
+    /// outside the image are rendered as if the image extended there).
+    #[must_use]
+    pub fn pixel(&self, x: u32, y: u32, stats: &mut RenderStats) -> Rgb {
+        let s = &self.settings;
+        let index = y.wrapping_mul(s.width).wrapping_add(x);
+        let mut sum = Vec3::ZERO;
+        for k in 0..s.spp {
+            let mut stream = SampleStream::new(s.sampler, index, k, s.spp, s.seed);
+            sum += integrator::sample_radiance(self, x, y, &mut stream, stats);
+        }
+        (sum / s.spp as f32).to_array()
+    }
+
+    /// Renders `tile` as linear RGB into `out` (row-major within the tile, `width·height`
+    /// entries).
+    ///
+    /// # Errors
+    /// [`Item::Tile`] errors for a tile outside the image or an `out` too small.
+    pub fn render_tile(&self, tile: Tile, out: &mut [Rgb]) -> Result<RenderStats, SceneError> {
+        let n = self.check_tile(tile, out.len(), 1)?;
+        let mut stats = RenderStats::default();
+        for (i, px) in out.iter_mut().take(n).enumerate() {
+            let (dx, dy) = ((i as u32) % tile.width, (i as u32) / tile.width);
+            *px = self.pixel(tile.x + dx, tile.y + dy, &mut stats);
+        }
+        Ok(stats)
+    }
+
+    /// Renders `tile` as 8-bit sRGB into `out` (3 bytes per pixel, row-major within the tile).
+    ///
+    /// # Errors
+    /// As [`Renderer::render_tile`].
+    pub fn render_tile_srgb8(&self, tile: Tile, out: &mut [u8]) -> Result<RenderStats, SceneError> {
+        let n = self.check_tile(tile, out.len(), 3)?;
+        let mut stats = RenderStats::default();
+        for (i, px) in out.chunks_exact_mut(3).take(n).enumerate() {
+            let (dx, dy) = ((i as u32) % tile.width, (i as u32) / tile.width);
+            let c = self.pixel(tile.x + dx, tile.y + dy, &mut stats);
+            for (b, v) in px.iter_mut().zip(c) {
+                *b = encode_srgb8(v);
+            }
+        }
+        Ok(stats)
+    }
+
+    /// The whole image as 8-bit sRGB, single-threaded: the reference the host's parallel
+    /// renders must equal.
+    ///
+    /// # Errors
+    /// As [`Renderer::render_tile`].
+    pub fn render_srgb8(&self, out: &mut [u8]) -> Result<RenderStats, SceneError> {
+        let tile = Tile {
+            x: 0,
+            y: 0,
+            width: self.settings.width,
+            height: self.settings.height,
+        };
+        self.render_tile_srgb8(tile, out)
+    }
+
+    /// Checks a tile against the image and a buffer of `len` entries of `per_pixel` units;
+    /// returns the pixel count.
+    fn check_tile(&self, t: Tile, len: usize, per_pixel: usize) -> Result<usize, SceneError> {
+        let err = |field, p| SceneError::new(Item::Tile, 0, field, p);
+        let s = &self.settings;
+        let fits =
+            |start: u32, size: u32, max: u32| start.checked_add(size).is_some_and(|e| e <= max);
+        if !fits(t.x, t.width, s.width) {
+            let p = Problem::OutOfRange {
+                min: 0.0,
+                max: s.width as f32,
+            };
+            return Err(err("width", p));
+        }
+        if !fits(t.y, t.height, s.height) {
+            let p = Problem::OutOfRange {
+                min: 0.0,
+                max: s.height as f32,
+            };
+            return Err(err("height", p));
+        }
+        let n = t.width as usize * t.height as usize;
+        let needed = n.saturating_mul(per_pixel);
+        if len < needed {
+            return Err(err(
+                "out",
+                Problem::TooSmall {
+                    needed,
+                    available: len,
+                },
+            ));
+        }
+        Ok(n)
+    }
+}
+
+/// Linear `[0, 1]` to 8-bit sRGB (IEC 61966-2-1 transfer function), rounded to nearest;
+/// values outside `[0, 1]` (and NaN) clip.
+#[must_use]
+pub fn encode_srgb8(linear: f32) -> u8 {
+    let c = if linear > 0.0 { linear } else { 0.0 };
+    let c = if c < 1.0 { c } else { 1.0 };
+    let s = if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * libm::powf(c, 1.0 / 2.4) - 0.055
+    };
+    (s * 255.0 + 0.5) as u8
+}
+
+fn check_settings(s: &Settings) -> Result<(), SceneError> {
+    let err = |field, p| Err(SceneError::new(Item::Settings, 0, field, p));
+    if s.width == 0 {
+        return err("width", Problem::NotPositive);
+    }
+    if s.height == 0 {
+        return err("height", Problem::NotPositive);
+    }
+    if s.spp == 0 {
+        return err("spp", Problem::NotPositive);
+    }
+    if s.width.checked_mul(s.height).is_none() {
+        let p = Problem::OutOfRange {
+            min: 1.0,
+            max: u32::MAX as f32,
+        };
+        return err("height", p);
+    }
+    Ok(())
+}
+
+fn check_materials<S: SpawnScalar>(scene: &Scene<'_, S>) -> Result<(), SceneError> {
+    for (i, m) in scene.materials.iter().enumerate() {
+        let err = |field, p| SceneError::new(Item::Material, i, field, p);
+        match *m {
+            Material::Diffuse { albedo } => {
+                scene::check_rgb(albedo, true).map_err(|p| err("albedo", p))?;
+            }
+            Material::Mirror { reflectance } => {
+                scene::check_rgb(reflectance, true).map_err(|p| err("reflectance", p))?;
+            }
+            Material::Glossy {
+                reflectance,
+                exponent,
+            } => {
+                scene::check_rgb(reflectance, true).map_err(|p| err("reflectance", p))?;
+                if !exponent.is_finite() {
+                    return Err(err("exponent", Problem::NonFinite));
+                }
+                if exponent < 1.0 {
+                    let p = Problem::OutOfRange {
+                        min: 1.0,
+                        max: f32::MAX,
+                    };
+                    return Err(err("exponent", p));
+                }
+            }
+            Material::Emissive { radiance } => {
+                scene::check_rgb(radiance, false).map_err(|p| err("radiance", p))?;
+            }
+        }
+    }
+    for (i, o) in scene.objects.iter().enumerate() {
+        if o.material as usize >= scene.materials.len() {
+            let p = Problem::Index {
+                len: scene.materials.len(),
+            };
+            return Err(SceneError::new(Item::Object, i, "material", p));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,308 @@
+//! Counter-based sample generation and the warps that turn unit-square samples into directions
+//! and points.
+//!
+//! Every value is a pure function of `(pixel, sample, dimension, seed)`: no generator state is
+//! carried between pixels, so any pixel renders alone, in any order, on any thread, with the
+//! same bits. Three samplers share that contract:
+//!
+//! - [`SamplerKind::Independent`]: a hash per value.
+//! - [`SamplerKind::Stratified`] (default): each 2D dimension pair puts the pixel's samples in
+//!   the cells of a `cols × rows` grid (`cols = ⌈√spp⌉`), one sample per cell when `spp` fills
+//!   the grid, in a per-pixel, per-dimension shuffled order, jittered inside its cell.
+//! - [`SamplerKind::Sobol`]: the first two Sobol dimensions with hash-based Owen scrambling and
+//!   a scrambled sample order per dimension pair (Burley 2020, "Practical Hash-based Owen
+//!   Scrambling"): no tables, low discrepancy at every power-of-two sample count.
+
+use core::f32::consts::PI;
+use glam::Vec3;
+
+/// How sample points are placed within a pixel's sample set.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum SamplerKind {
+    /// Independent uniform values (a hash per value).
+    Independent,
+    /// Jittered grid per dimension pair (the default).
+    #[default]
+    Stratified,
+    /// Owen-scrambled Sobol (0,2)-sequence per dimension pair, shuffled per pair.
+    Sobol,
+}
+
+impl SamplerKind {
+    /// Every sampler, for tests and benchmarks.
+    pub const ALL: [SamplerKind; 3] = [Self::Independent, Self::Stratified, Self::Sobol];
+
+    /// Lower-case name as used on command lines.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Independent => "independent",
+            Self::Stratified => "stratified",
+            Self::Sobol => "sobol",
+        }
+    }
+}
+
+/// A 32-bit integer hash with good avalanche (the "lowbias32" constants of C. Wellons'
+/// hash-prospector search).
+#[must_use]
+pub const fn hash(mut x: u32) -> u32 {
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^= x >> 16;
+    x
+}
+
+/// Hash of several words, order-sensitive.
+#[must_use]
+pub const fn hash4(a: u32, b: u32, c: u32, d: u32) -> u32 {
+    hash(d ^ hash(c ^ hash(b ^ hash(a))))
+}
+
+/// The top 24 bits of `x` as a float in `[0, 1)` (exact: every value is a multiple of 2^-24).
+#[must_use]
+pub fn unit_float(x: u32) -> f32 {
+    (x >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// Nested uniform (Owen) scramble of a 32-bit fraction in base 2: each bit is flipped by a
+/// hash of the bits above it. Implemented as Burley's Laine–Karras-style hash on the
+/// bit-reversed value (each multiply only carries information towards more significant bits of
+/// the reversed word, i.e. towards less significant bits of the fraction).
+#[must_use]
+pub const fn owen_scramble(x: u32, seed: u32) -> u32 {
+    let mut v = x.reverse_bits();
+    v = v.wrapping_add(seed);
+    v ^= v.wrapping_mul(0x6c50_b47c);
+    v ^= v.wrapping_mul(0xb82f_1e52);
+    v ^= v.wrapping_mul(0xc7af_e638);
+    v ^= v.wrapping_mul(0x8d22_f6e6);
+    v.reverse_bits()
+}
+
+/// First Sobol dimension (the van der Corput sequence): the index's bits reversed.
+#[must_use]
+pub const fn sobol_0(index: u32) -> u32 {
+    index.reverse_bits()
+}
+
+/// Second Sobol dimension: direction numbers `v_0 = 2^31`, `v_{k+1} = v_k ^ (v_k >> 1)` (the
+/// rows of Pascal's triangle mod 2).
+#[must_use]
+pub const fn sobol_1(mut index: u32) -> u32 {
+    let mut v = 1u32 << 31;
+    let mut r = 0;
+    while index != 0 {
+        if index & 1 != 0 {
+            r ^= v;
+        }
+        index >>= 1;
+        v ^= v >> 1;
+    }
+    r
+}
+
+/// A bijection of `0..n` chosen by `seed` (`index < n` required; other inputs are returned
+/// unchanged). Cycle-walks a seeded bijection of `0..2^k` (`2^k >= n`), so it takes fewer than
+/// `2^k < 2n` steps.
+#[must_use]
+pub fn permute(index: u32, n: u32, seed: u32) -> u32 {
+    if index >= n || n <= 1 {
+        return index;
+    }
+    let mask = u32::MAX >> (n - 1).leading_zeros();
+    let mut i = index;
+    // Bounded: `i` walks the cycle of a permutation of 0..=mask that contains `index`.
+    for _ in 0..=mask {
+        // Each step is a bijection on 0..=mask: xor, odd multiply, xor-shift, all masked.
+        i ^= seed & mask;
+        i = i.wrapping_mul(0x9e37_79b1 | 1) & mask;
+        i ^= (i & mask) >> 3;
+        i = i.wrapping_mul((seed >> 16) | 1) & mask;
+        i ^= (i & mask) >> 5;
+        i = i.wrapping_add(seed >> 8) & mask;
+        if i < n {
+            return i;
+        }
+    }
+    index
+}
+
+/// The sample stream of one pixel sample: hands out dimension pairs in a fixed order.
+///
+/// Dimension pairs are numbered from 0 in the order the renderer asks for them (pixel position,
+/// lens, time, then per bounce the lights' and the lobe's), so a sample's values depend only on
+/// `(pixel, sample, pair, seed)`.
+#[derive(Clone, Copy, Debug)]
+pub struct SampleStream {
+    kind: SamplerKind,
+    pixel: u32,
+    sample: u32,
+    spp: u32,
+    seed: u32,
+    pair: u32,
+}
+
+impl SampleStream {
+    /// The stream of sample `sample` (of `spp`) of pixel `pixel` (a linear pixel index).
+    #[must_use]
+    pub const fn new(kind: SamplerKind, pixel: u32, sample: u32, spp: u32, seed: u32) -> Self {
+        Self {
+            kind,
+            pixel,
+            sample,
+            spp,
+            seed,
+            pair: 0,
+        }
+    }
+
+    /// The next dimension pair, in `[0, 1)²`.
+    pub fn next_2d(&mut self) -> (f32, f32) {
+        let pair = self.pair;
+        self.pair = self.pair.wrapping_add(1);
+        let key = hash4(self.pixel, pair, self.seed, 0x5eed_0001);
+        match self.kind {
+            SamplerKind::Independent => {
+                let h = hash4(self.pixel, self.sample, pair, self.seed);
+                (unit_float(h), unit_float(hash(h ^ 0x68e3_1da4)))
+            }
+            SamplerKind::Stratified => {
+                let cols = ceil_sqrt(self.spp);
+                let rows = self.spp.div_ceil(cols).max(1);
+                let cell = permute(self.sample, self.spp, key);
+                let (cx, cy) = (cell % cols, cell / cols);
+                let h = hash4(self.pixel, self.sample, pair, self.seed ^ 0x2545_f491);
+                let jx = unit_float(h);
+                let jy = unit_float(hash(h ^ 0x68e3_1da4));
+                (
+                    below_one((cx as f32 + jx) / cols as f32),
+                    below_one((cy as f32 + jy) / rows as f32),
+                )
+            }
+            SamplerKind::Sobol => {
+                let index = owen_scramble(self.sample, key);
+                let x = owen_scramble(sobol_0(index), hash(key ^ 0xa511_e9b3));
+                let y = owen_scramble(sobol_1(index), hash(key ^ 0x63d8_3595));
+                (unit_float(x), unit_float(y))
+            }
+        }
+    }
+}
+
+/// `⌈√n⌉` for `n >= 1` (1 for 0), in integers.
+#[must_use]
+pub fn ceil_sqrt(n: u32) -> u32 {
+    // An estimate from f64 (exact for squares below 2^52), then corrected in integers.
+    let mut c = (libm::sqrt(f64::from(n)) as u32).max(1);
+    while u64::from(c) * u64::from(c) < u64::from(n) {
+        c += 1;
+    }
+    while c > 1 && u64::from(c - 1) * u64::from(c - 1) >= u64::from(n) {
+        c -= 1;
+    }
+    c
+}
+
+/// Clamps a value that rounding may have pushed to 1 to the largest float below 1.
+fn below_one(x: f32) -> f32 {
+    if x < 1.0 {
+        x
+    } else {
+        1.0 - f32::EPSILON / 2.0
+    }
+}
+
+/// A tent-distributed offset in `(-1, 1)` from a uniform `u` in `[0, 1)` (inverse CDF of the
+/// triangle filter of radius 1).
+#[must_use]
+pub fn tent(u: f32) -> f32 {
+    let v = 2.0 * u;
+    if v < 1.0 {
+        libm::sqrtf(v) - 1.0
+    } else {
+        1.0 - libm::sqrtf(2.0 - v)
+    }
+}
+
+/// A point on the unit disk, area-uniform (Shirley–Chiu concentric map).
+#[must_use]
+pub fn concentric_disk(u: f32, v: f32) -> (f32, f32) {
+    let a = 2.0 * u - 1.0;
+    let b = 2.0 * v - 1.0;
+    if a == 0.0 && b == 0.0 {
+        return (0.0, 0.0);
+    }
+    let (r, phi) = if abs(a) > abs(b) {
+        (a, (PI / 4.0) * (b / a))
+    } else {
+        (b, PI / 2.0 - (PI / 4.0) * (a / b))
+    };
+    (r * libm::cosf(phi), r * libm::sinf(phi))
+}
+
+/// A direction around `+z` with density `(n+1)/(2π)·cos^n θ` over the hemisphere (the
+/// normalised Phong lobe). `n = 1` is not cosine-weighted sampling (that is
+/// [`cosine_hemisphere`]); the lobe is over solid angle.
+#[must_use]
+pub fn phong_lobe(u: f32, v: f32, exponent: f32) -> Vec3 {
+    let cos_t = libm::powf(1.0 - u, 1.0 / (exponent + 1.0));
+    let sin_t = libm::sqrtf(max0(1.0 - cos_t * cos_t));
+    let phi = 2.0 * PI * v;
+    Vec3::new(sin_t * libm::cosf(phi), sin_t * libm::sinf(phi), cos_t)
+}
+
+/// A direction around `+z` with density `cos θ / π` (Malley's method on the concentric disk).
+#[must_use]
+pub fn cosine_hemisphere(u: f32, v: f32) -> Vec3 {
+    let (x, y) = concentric_disk(u, v);
+    Vec3::new(x, y, libm::sqrtf(max0(1.0 - x * x - y * y)))
+}
+
+/// A direction in the cone of half-angle `acos(cos_max)` around `+z`, uniform in solid angle
+/// (density `1 / (2π(1 − cos_max))`).
+#[must_use]
+pub fn uniform_cone(u: f32, v: f32, cos_max: f32) -> Vec3 {
+    let cos_t = 1.0 - u * (1.0 - cos_max);
+    let sin_t = libm::sqrtf(max0(1.0 - cos_t * cos_t));
+    let phi = 2.0 * PI * v;
+    Vec3::new(sin_t * libm::cosf(phi), sin_t * libm::sinf(phi), cos_t)
+}
+
+/// An orthonormal basis `(t, b)` completing the unit vector `n` (Duff et al. 2017, branch on
+/// the sign of `n.z`; `copysign` written as an explicit comparison).
+#[must_use]
+pub fn basis(n: Vec3) -> (Vec3, Vec3) {
+    let sign = if n.z < 0.0 { -1.0 } else { 1.0 };
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (
+        Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        Vec3::new(b, sign + n.y * n.y * a, -n.y),
+    )
+}
+
+/// `local` (around `+z`) expressed in the frame whose `z` axis is the unit vector `n`.
+#[must_use]
+pub fn to_world(local: Vec3, n: Vec3) -> Vec3 {
+    let (t, b) = basis(n);
+    t * local.x + b * local.y + n * local.z
+}
+
+fn abs(x: f32) -> f32 {
+    if x < 0.0 {
+        -x
+    } else {
+        x
+    }
+}
+
+fn max0(x: f32) -> f32 {
+    if x > 0.0 {
+        x
+    } else {
+        0.0
+    }
+}
