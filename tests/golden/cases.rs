@@ -9,6 +9,9 @@
 #![allow(dead_code)]
 
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
+use raykernel::geom::spawn::SpawnScalar;
+use raykernel::render::scenes::{self, SceneData};
+use raykernel::render::{AccelChoice, Object, Renderer, Shape, Tile};
 use raykernel::{Accel, Bvh, Hit, Linear, Node, Primitive, Ray, Scalar, Sphere, Triangle, I16F16};
 
 /// Triangles of the level-1 icosphere.
@@ -22,7 +25,7 @@ const CENTER: [f32; 3] = [0.375, -0.25, 0.625];
 const RADIUS: f32 = 2.0;
 
 /// Every golden case, in file order.
-pub const NAMES: [&str; 12] = [
+pub const NAMES: [&str; 18] = [
     "rays_f32",
     "rays_fixed",
     "linear_f32",
@@ -35,6 +38,12 @@ pub const NAMES: [&str; 12] = [
     "tree_fixed_sah",
     "tree_fixed_median",
     "tree_fixed_midpoint",
+    "render_cornell_f32",
+    "render_cornell_fixed",
+    "render_spheres_f32",
+    "render_spheres_fixed",
+    "render_motion_f32",
+    "render_motion_fixed",
 ];
 
 /// What went wrong while computing a case.
@@ -68,6 +77,13 @@ impl Fnv {
     }
     pub fn u32(&mut self, x: u32) {
         for b in x.to_le_bytes() {
+            self.0 ^= b as u64;
+            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+    /// Feeds bytes in order (so `u32(x)` equals `bytes(&x.to_le_bytes())`).
+    pub fn bytes(&mut self, bytes: &[u8]) {
+        for &b in bytes {
             self.0 ^= b as u64;
             self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
         }
@@ -368,7 +384,81 @@ fn spheres_case<S: Bits>() -> Result<u64, Fail> {
     hash_queries(&linear)
 }
 
-/// Computes the case called `name`.
+/// Largest built-in scene, in triangles, spheres and objects (the buffers below are sized
+/// for it; a bigger scene fails with [`Fail::Rejected`]).
+const RENDER_TRIS: usize = 24;
+const RENDER_SPHERES: usize = 4;
+const RENDER_OBJECTS: usize = 8;
+/// Widest built-in render (pixels), for the one-row buffer.
+const RENDER_WIDTH: usize = 64;
+
+/// Renders built-in scene `data` at its own settings, one row at a time
+/// (so the M0 needs no framebuffer), and hashes the 8-bit sRGB bytes in row-major order: the
+/// same value as FNV-1a over the whole image's bytes.
+#[inline(never)] // one case's buffers on the stack at a time (the M0 has 16 KB of RAM)
+pub fn render_hash<S: Bits + SpawnScalar>(data: &SceneData<'_>) -> Result<u64, Fail> {
+    let reject = |_| Fail::Rejected { index: 0 };
+    let mut tris = [Triangle::<S> {
+        v: [[S::ZERO; 3]; 3],
+    }; RENDER_TRIS];
+    let mut spheres = [Sphere::<S> {
+        center: [S::ZERO; 3],
+        radius: S::ZERO,
+    }; RENDER_SPHERES];
+    let (nt, ns) = (data.triangles.len(), data.spheres.len());
+    let tris = tris.get_mut(..nt).ok_or(Fail::Rejected { index: nt })?;
+    let spheres = spheres.get_mut(..ns).ok_or(Fail::Rejected { index: ns })?;
+    data.triangles_into(tris).map_err(reject)?;
+    data.spheres_into(spheres).map_err(reject)?;
+    let mut objects = [Object::new(Shape::Triangles(&[]), 0); RENDER_OBJECTS];
+    let scene = data.scene(tris, spheres, &mut objects).map_err(reject)?;
+    let mut nodes = [Node::<S>::EMPTY;
+        nodes_needed(RENDER_TRIS) + nodes_needed(RENDER_SPHERES) + 2 * RENDER_OBJECTS];
+    let mut ids = [0u32; RENDER_TRIS + RENDER_SPHERES];
+    let accel = AccelChoice::default();
+    let r = Renderer::new(&scene, data.settings, accel, &mut nodes, &mut ids).map_err(reject)?;
+    let width = data.settings.width as usize;
+    let mut row = [0u8; 3 * RENDER_WIDTH];
+    let row = row
+        .get_mut(..3 * width)
+        .ok_or(Fail::Rejected { index: width })?;
+    let mut h = Fnv::new();
+    for y in 0..data.settings.height {
+        let tile = Tile {
+            x: 0,
+            y,
+            width: data.settings.width,
+            height: 1,
+        };
+        r.render_tile_srgb8(tile, row).map_err(reject)?;
+        h.bytes(row);
+    }
+    Ok(h.finish())
+}
+
+/// Computes the render case called `name` (kept apart from [`compute`] so a binary that checks
+/// only the kernel cases does not link the renderer).
+pub fn compute_render(name: &str) -> Result<u64, Fail> {
+    match name {
+        "render_cornell_f32" => render_hash::<f32>(&scenes::CORNELL),
+        "render_cornell_fixed" => render_hash::<I16F16>(&scenes::CORNELL),
+        "render_spheres_f32" => render_hash::<f32>(&scenes::SPHERES),
+        "render_spheres_fixed" => render_hash::<I16F16>(&scenes::SPHERES),
+        "render_motion_f32" => render_hash::<f32>(&scenes::MOTION),
+        "render_motion_fixed" => render_hash::<I16F16>(&scenes::MOTION),
+        _ => Err(Fail::UnknownCase),
+    }
+}
+
+/// Computes any case, kernel or render.
+pub fn compute_any(name: &str) -> Result<u64, Fail> {
+    match compute(name) {
+        Err(Fail::UnknownCase) => compute_render(name),
+        r => r,
+    }
+}
+
+/// Computes the kernel (non-render) case called `name`.
 pub fn compute(name: &str) -> Result<u64, Fail> {
     use BuilderKind::{Median, Midpoint, Sah};
     match name {

@@ -1,4 +1,4 @@
-//! Puts memory.x on the linker path and turns the golden hash file into Rust source, so the
+//! Writes memory.x (from memory.x.in, RAM sized per target) on the linker path and turns the golden hash file into Rust source, so the
 //! on-target tests compare with the same file the host test reads (no second copy).
 
 use std::env;
@@ -8,9 +8,17 @@ use std::path::PathBuf;
 
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").expect("OUT_DIR"));
-    fs::copy("memory.x", out.join("memory.x")).expect("copy memory.x");
+    // memory.x describes the micro:bit (16 KB of RAM); the LM3S6965 and the MPS2 have 64 KB
+    // or more, which the render tests need.
+    let memory = fs::read_to_string("memory.x.in").expect("read memory.x.in");
+    let memory = if env::var("TARGET").is_ok_and(|t| t != "thumbv6m-none-eabi") {
+        memory.replace("LENGTH = 16K", "LENGTH = 64K")
+    } else {
+        memory
+    };
+    fs::write(out.join("memory.x"), memory).expect("write memory.x");
     println!("cargo:rustc-link-search={}", out.display());
-    println!("cargo:rerun-if-changed=memory.x");
+    println!("cargo:rerun-if-changed=memory.x.in");
 
     let golden = "../golden/kernel_hashes.txt";
     println!("cargo:rerun-if-changed={golden}");

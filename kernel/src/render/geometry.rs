@@ -26,8 +26,9 @@ use crate::scalar::Scalar;
 /// solves a quadratic: its roots near the surface carry more rounding than a plane's).
 pub const SPHERE_SPAWN_FACTOR: f64 = 8.0;
 
-/// Most objects a scene may have.
-pub const MAX_OBJECTS: usize = 32;
+/// Most objects a scene may have (the renderer keeps one accelerator per object inline, so
+/// this bounds its size: about 100 bytes per object on 32-bit targets).
+pub const MAX_OBJECTS: usize = 16;
 /// Most lights a scene may have.
 pub const MAX_LIGHTS: usize = 8;
 

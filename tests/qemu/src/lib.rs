@@ -14,3 +14,98 @@ pub mod golden {
         GOLDEN.iter().find(|(n, _)| *n == name).map(|&(_, v)| v)
     }
 }
+
+use cases::Fail;
+
+/// A short description of a failed case.
+pub fn fail_name(f: Fail) -> &'static str {
+    match f {
+        Fail::UnknownCase => "unknown case",
+        Fail::Rejected { .. } => "kernel rejected generated input",
+        Fail::Build => "build failed",
+        Fail::Invalid => "validate() rejected the tree",
+        Fail::Differs { .. } => "BVH differs from brute force",
+    }
+}
+
+/// Computes golden case `name` on target and compares with the host-generated table.
+pub fn check_golden(name: &str) {
+    check_golden_with(name, cases::compute)
+}
+
+/// As [`check_golden`] for a render case.
+pub fn check_render_golden(name: &str) {
+    check_golden_with(name, cases::compute_render)
+}
+
+fn check_golden_with(name: &str, compute: fn(&str) -> Result<u64, Fail>) {
+    let want = golden::expected(name);
+    defmt::assert!(want.is_some(), "{} missing from kernel_hashes.txt", name);
+    match compute(name) {
+        Ok(got) => defmt::assert_eq!(
+            got,
+            want.unwrap_or(0),
+            "golden {}: computed {=u64:#018x}, file {=u64:#018x}",
+            name,
+            got,
+            want.unwrap_or(0)
+        ),
+        Err(e) => defmt::panic!("golden {}: {}", name, fail_name(e)),
+    }
+}
+
+/// Stack painting: how much stack a piece of code uses, measured on target.
+pub mod stack {
+    /// The pattern free stack is painted with.
+    const PAINT: u32 = 0xa5c3_5a3c;
+
+    extern "C" {
+        /// The linker's lowest stack address (cortex-m-rt); the stack grows down towards it.
+        static _stack_end: u32;
+        /// The top of the stack (end of RAM).
+        static _stack_start: u32;
+    }
+
+    pub fn stack_bottom() -> usize {
+        core::ptr::addr_of!(_stack_end) as usize
+    }
+
+    /// Fills the free stack from its end up to `top` with a pattern.
+    #[inline(never)]
+    pub fn paint(top: usize) {
+        let mut p = stack_bottom();
+        while p < top {
+            // SAFETY: [stack end, top) is free stack below the caller's frame, word aligned.
+            unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
+            p += 4;
+        }
+    }
+
+    /// The lowest address at or below `top` whose paint was overwritten.
+    #[inline(never)]
+    pub fn lowest_used(top: usize) -> usize {
+        let mut p = stack_bottom();
+        // SAFETY: as in `paint`; reads only.
+        while p < top && unsafe { core::ptr::read_volatile(p as *const u32) } == PAINT {
+            p += 4;
+        }
+        defmt::assert!(p > stack_bottom(), "stack overflowed its painted region");
+        p
+    }
+
+    /// Fills the free stack below the caller's frame with a pattern, runs `f`, and returns how
+    /// many bytes below the painted top `f` used (found by scanning up from the stack's end).
+    #[inline(never)]
+    pub fn stack_use(f: impl FnOnce()) -> usize {
+        const GAP: usize = 256; // left alone: this frame and the calls painting makes
+        let top = cortex_m::register::msp::read() as usize - GAP;
+        paint(top);
+        f();
+        top - lowest_used(top)
+    }
+
+    /// The top of the stack (the end of RAM).
+    pub fn stack_top() -> usize {
+        core::ptr::addr_of!(_stack_start) as usize
+    }
+}

@@ -10,8 +10,9 @@ use panic_probe as _; // prints the panic via defmt, then `udf` -> HardFault
 
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::{Accel, Bvh, Linear, Node, Primitive, Scalar, Triangle};
-use raykernel_qemu::cases::{self, Bits, Fail, ICO_TRIS};
+use raykernel_qemu::cases::{self, Bits, ICO_TRIS};
 use raykernel_qemu::golden;
+use raykernel_qemu::{check_golden, fail_name, stack};
 
 #[defmt::panic_handler]
 fn defmt_panic() -> ! {
@@ -22,33 +23,6 @@ fn defmt_panic() -> ! {
 #[cortex_m_rt::exception]
 unsafe fn HardFault(_: &cortex_m_rt::ExceptionFrame) -> ! {
     semihosting::process::exit(101)
-}
-
-fn fail_name(f: Fail) -> &'static str {
-    match f {
-        Fail::UnknownCase => "unknown case",
-        Fail::Rejected { .. } => "kernel rejected generated input",
-        Fail::Build => "build failed",
-        Fail::Invalid => "validate() rejected the tree",
-        Fail::Differs { .. } => "BVH differs from brute force",
-    }
-}
-
-/// Computes golden case `name` on target and compares with the host-generated table.
-fn check_golden(name: &str) {
-    let want = golden::expected(name);
-    defmt::assert!(want.is_some(), "{} missing from kernel_hashes.txt", name);
-    match cases::compute(name) {
-        Ok(got) => defmt::assert_eq!(
-            got,
-            want.unwrap_or(0),
-            "golden {}: computed {=u64:#018x}, file {=u64:#018x}",
-            name,
-            got,
-            want.unwrap_or(0)
-        ),
-        Err(e) => defmt::panic!("golden {}: {}", name, fail_name(e)),
-    }
 }
 
 fn near(x: f32, want: f32, tol: f32) -> bool {
@@ -305,53 +279,6 @@ fn error_cases<S: Scalar>() {
     defmt::assert!(r(z, x, -1.0, 1.0) == Some(RayError::InvalidInterval));
 }
 
-const PAINT: u32 = 0xa5c3_5a3c;
-
-extern "C" {
-    /// The linker's lowest stack address (cortex-m-rt); the stack grows down towards it.
-    static _stack_end: u32;
-    /// The top of the stack (end of RAM).
-    static _stack_start: u32;
-}
-
-fn stack_bottom() -> usize {
-    core::ptr::addr_of!(_stack_end) as usize
-}
-
-/// Fills the free stack from its end up to `top` with a pattern.
-#[inline(never)]
-fn paint(top: usize) {
-    let mut p = stack_bottom();
-    while p < top {
-        // SAFETY: [stack end, top) is free stack below the caller's frame, word aligned.
-        unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
-        p += 4;
-    }
-}
-
-/// The lowest address at or below `top` whose paint was overwritten.
-#[inline(never)]
-fn lowest_used(top: usize) -> usize {
-    let mut p = stack_bottom();
-    // SAFETY: as in `paint`; reads only.
-    while p < top && unsafe { core::ptr::read_volatile(p as *const u32) } == PAINT {
-        p += 4;
-    }
-    defmt::assert!(p > stack_bottom(), "stack overflowed its painted region");
-    p
-}
-
-/// Fills the free stack below the caller's frame with a pattern, runs `f`, and returns how
-/// many bytes below the painted top `f` used (found by scanning up from the stack's end).
-#[inline(never)]
-fn stack_use(f: impl FnOnce()) -> usize {
-    const GAP: usize = 256; // left alone: this frame and the calls painting makes
-    let top = cortex_m::register::msp::read() as usize - GAP;
-    paint(top);
-    f();
-    top - lowest_used(top)
-}
-
 fn stack_case<S: Bits>() -> (usize, usize) {
     let mut tris = cases::empty_mesh::<S>();
     if let Err(e) = cases::icosphere(&mut tris) {
@@ -359,7 +286,7 @@ fn stack_case<S: Bits>() -> (usize, usize) {
     }
     let mut nodes = [Node::<S>::EMPTY; nodes_needed(ICO_TRIS)];
     let mut ids = [0u32; ICO_TRIS];
-    let build = stack_use(|| {
+    let build = stack::stack_use(|| {
         let b = Bvh::build(&tris, &mut nodes, &mut ids, BuildOptions::default());
         core::hint::black_box(b.is_ok());
     });
@@ -368,7 +295,7 @@ fn stack_case<S: Bits>() -> (usize, usize) {
         defmt::panic!("build failed")
     };
     let mut hits = 0;
-    let trace = stack_use(|| {
+    let trace = stack::stack_use(|| {
         for i in 0..cases::RAY_COUNT {
             if let Ok(r) = cases::ray::<S>(i) {
                 hits += bvh.intersect(&r).is_some() as u32;
@@ -388,7 +315,7 @@ mod tests {
     #[test]
     fn golden_table_and_case_list_agree() {
         // First test: paint the free stack, so the last test can report the peak of the run.
-        super::paint(cortex_m::register::msp::read() as usize - 256);
+        stack::paint(cortex_m::register::msp::read() as usize - 256);
         defmt::assert_eq!(golden::GOLDEN.len(), cases::NAMES.len());
         for (&(name, _), &case) in golden::GOLDEN.iter().zip(cases::NAMES.iter()) {
             defmt::assert_eq!(name, case);
@@ -501,9 +428,9 @@ mod tests {
     /// on the micro:bit). Fails when less than 512 bytes stay free, before an overflow would.
     #[test]
     fn stack_headroom_of_the_whole_run() {
-        let top = core::ptr::addr_of!(super::_stack_start) as usize;
-        let low = super::lowest_used(top);
-        let free = low - super::stack_bottom();
+        let top = stack::stack_top();
+        let low = stack::lowest_used(top);
+        let free = low - stack::stack_bottom();
         defmt::info!(
             "stack peak of the run: {=usize} B used, {=usize} B free",
             top - low,

@@ -1,0 +1,926 @@
+//! The distribution ray tracer: known-answer renders (radiance from analytic formulas),
+//! sampling functions against their known integrals and stratification properties, tile and
+//! order independence, the render plan, and every typed scene error.
+
+use raykernel::bvh::{BuildOptions, BuilderKind};
+use raykernel::geom::spawn::SpawnScalar;
+use raykernel::render::sampling::{
+    concentric_disk, cosine_hemisphere, owen_scramble, permute, phong_lobe, sobol_0, sobol_1, tent,
+    to_world, uniform_cone, SampleStream,
+};
+use raykernel::render::scenes::{self, SceneData};
+use raykernel::render::{
+    memory_needed, AccelChoice, Camera, Filter, Item, Light, Material, Object, Problem, Renderer,
+    SamplerKind, Scene, SceneError, Settings, Shape, Tile, MAX_LIGHTS, MAX_OBJECTS,
+};
+use raykernel::{Node, Sphere, Triangle, I16F16};
+use std::f64::consts::PI;
+
+/// Renders `scene` into linear RGB with a BVH (or brute force).
+fn render<S: SpawnScalar>(
+    scene: &Scene<'_, S>,
+    settings: Settings,
+    accel: AccelChoice,
+) -> Result<Vec<[f32; 3]>, SceneError> {
+    let (n, i) = memory_needed(scene.objects);
+    let mut nodes = vec![Node::EMPTY; n];
+    let mut ids = vec![0u32; i];
+    let r = Renderer::new(scene, settings, accel, &mut nodes, &mut ids)?;
+    let mut out = vec![[0.0f32; 3]; (settings.width * settings.height) as usize];
+    let tile = Tile {
+        x: 0,
+        y: 0,
+        width: settings.width,
+        height: settings.height,
+    };
+    r.render_tile(tile, &mut out)?;
+    Ok(out)
+}
+
+fn tris<S: SpawnScalar>(t: &[[[f32; 3]; 3]]) -> Vec<Triangle<S>> {
+    t.iter().map(|v| Triangle::from_f32(*v).unwrap()).collect()
+}
+
+fn sphere<S: SpawnScalar>(c: [f32; 3], r: f32) -> Sphere<S> {
+    Sphere {
+        center: c.map(|x| S::coord_from_f32(x).unwrap()),
+        radius: S::coord_from_f32(r).unwrap(),
+    }
+}
+
+/// A square floor `[-s, s]²` at height 0.
+fn floor(s: f32) -> Vec<[[f32; 3]; 3]> {
+    vec![
+        [[-s, 0.0, -s], [-s, 0.0, s], [s, 0.0, s]],
+        [[-s, 0.0, -s], [s, 0.0, s], [s, 0.0, -s]],
+    ]
+}
+
+/// A camera looking at the origin from `eye` with a tiny field of view (the whole image sees
+/// one point of the floor).
+fn narrow_camera(eye: [f32; 3]) -> Camera {
+    Camera {
+        eye,
+        look_at: [0.0; 3],
+        up: [0.0, 0.0, -1.0],
+        vfov_deg: 0.001,
+        aperture_radius: 0.0,
+        focus_distance: 1.0,
+    }
+}
+
+fn one_pixel(spp: u32, sampler: SamplerKind) -> Settings {
+    Settings {
+        width: 1,
+        height: 1,
+        spp,
+        max_depth: 4,
+        sampler,
+        filter: Filter::Box,
+        seed: 5,
+    }
+}
+
+fn rel_err(got: f32, want: f64) -> f64 {
+    (f64::from(got) - want).abs() / want
+}
+
+/// Point light straight above the seen point: `L = ρ/π · I / h²`.
+fn point_light_case<S: SpawnScalar>() {
+    let t = tris::<S>(&floor(4.0));
+    let objects = [Object::new(Shape::Triangles(&t), 0)];
+    let (rho, intensity, h) = (0.6f32, 5.0f32, 1.5f32);
+    let scene = Scene {
+        objects: &objects,
+        materials: &[Material::Diffuse { albedo: [rho; 3] }],
+        lights: &[Light::Point {
+            position: [0.0, h, 0.0],
+            intensity: [intensity; 3],
+        }],
+        camera: narrow_camera([2.0, 2.0, 0.0]),
+        background: [0.0; 3],
+    };
+    let px = render(
+        &scene,
+        one_pixel(1, SamplerKind::Stratified),
+        AccelChoice::default(),
+    )
+    .unwrap();
+    let want = f64::from(rho) / PI * f64::from(intensity) / f64::from(h * h);
+    for c in px[0] {
+        assert!(rel_err(c, want) < 2e-4, "{}: got {c}, want {want}", S::NAME);
+    }
+}
+
+#[test]
+fn known_answer_point_light() {
+    point_light_case::<f32>();
+    point_light_case::<I16F16>();
+}
+
+/// Sphere light of radius `r` at height `d` above the seen point: `E = π·L·(r/d)²`, so
+/// `L_out = ρ·L·(r/d)²`.
+fn sphere_light_case<S: SpawnScalar>(sampler: SamplerKind) {
+    let t = tris::<S>(&floor(4.0));
+    let objects = [Object::new(Shape::Triangles(&t), 0)];
+    let (rho, radiance, r, d) = (0.5f32, 3.0f32, 0.5f32, 2.0f32);
+    let scene = Scene {
+        objects: &objects,
+        materials: &[Material::Diffuse { albedo: [rho; 3] }],
+        lights: &[Light::Sphere {
+            center: [0.0, d, 0.0],
+            radius: r,
+            radiance: [radiance; 3],
+        }],
+        camera: narrow_camera([3.0, 1.0, 0.0]),
+        background: [0.0; 3],
+    };
+    let px = render(&scene, one_pixel(1024, sampler), AccelChoice::default()).unwrap();
+    let want = f64::from(rho * radiance) * f64::from(r / d).powi(2);
+    for c in px[0] {
+        assert!(
+            rel_err(c, want) < 2e-3,
+            "{} {sampler:?}: got {c}, want {want}",
+            S::NAME
+        );
+    }
+}
+
+#[test]
+fn known_answer_sphere_light() {
+    for s in SamplerKind::ALL {
+        sphere_light_case::<f32>(s);
+        sphere_light_case::<I16F16>(s);
+    }
+}
+
+/// Irradiance at a point below the corner of a parallel `a × b` rectangle at height `h`, per
+/// unit radiance: `π·F` with the point-to-rectangle form factor
+/// `F = 1/(2π)·[X/√(1+X²)·atan(Y/√(1+X²)) + Y/√(1+Y²)·atan(X/√(1+Y²))]`, `X = a/h`, `Y = b/h`.
+fn corner_irradiance(a: f64, b: f64, h: f64) -> f64 {
+    let (x, y) = (a / h, b / h);
+    let sx = (1.0 + x * x).sqrt();
+    let sy = (1.0 + y * y).sqrt();
+    0.5 * (x / sx * (y / sx).atan() + y / sy * (x / sy).atan())
+}
+
+fn rect_light_case<S: SpawnScalar>() {
+    let t = tris::<S>(&floor(4.0));
+    let objects = [Object::new(Shape::Triangles(&t), 0)];
+    let (rho, radiance, half, h) = (0.7f32, 2.0f32, 0.5f32, 1.0f32);
+    let scene = Scene {
+        objects: &objects,
+        materials: &[Material::Diffuse { albedo: [rho; 3] }],
+        // Centred above the origin, facing down (edge_u × edge_v = -y).
+        lights: &[Light::Rect {
+            corner: [-half, h, -half],
+            edge_u: [2.0 * half, 0.0, 0.0],
+            edge_v: [0.0, 0.0, 2.0 * half],
+            radiance: [radiance; 3],
+        }],
+        camera: narrow_camera([3.0, 0.5, 0.0]),
+        background: [0.0; 3],
+    };
+    let px = render(
+        &scene,
+        one_pixel(4096, SamplerKind::Sobol),
+        AccelChoice::default(),
+    )
+    .unwrap();
+    let e = 4.0 * corner_irradiance(f64::from(half), f64::from(half), f64::from(h));
+    // L_out = ρ/π · E, E = L · Σ corner irradiances.
+    let want = f64::from(rho * radiance) * e / PI;
+    for c in px[0] {
+        assert!(rel_err(c, want) < 2e-3, "{}: got {c}, want {want}", S::NAME);
+    }
+}
+
+#[test]
+fn known_answer_rect_light() {
+    rect_light_case::<f32>();
+    rect_light_case::<I16F16>();
+}
+
+/// Furnace for reflections: inside a closed emissive box of radiance `L`, a mirror of
+/// reflectance `ρ` shows exactly `ρ·L`; a glossy sphere at most `ρ·L`, and `ρ·L` wherever no
+/// lobe sample falls below the surface; with no bounces left, a mirror is black.
+fn furnace_case<S: SpawnScalar>() {
+    let s = 3.0f32;
+    let corners = |x: f32, y: f32, z: f32| [x * s, y * s, z * s];
+    // The six faces of a cube.
+    let mut box_tris = Vec::new();
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let mut q = [[0.0f32; 3]; 4];
+            for (k, (u, v)) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .iter()
+                .enumerate()
+            {
+                let mut p = [0.0; 3];
+                p[axis] = sign;
+                p[(axis + 1) % 3] = *u;
+                p[(axis + 2) % 3] = *v;
+                q[k] = corners(p[0], p[1], p[2]);
+            }
+            box_tris.push([q[0], q[1], q[2]]);
+            box_tris.push([q[0], q[2], q[3]]);
+        }
+    }
+    let t = tris::<S>(&box_tris);
+    let mirror = [sphere::<S>([0.0, 0.0, 0.0], 1.0)];
+    let (rho, l) = (0.8f32, 1.5f32);
+    let objects = [
+        Object::new(Shape::Triangles(&t), 0),
+        Object::new(Shape::Spheres(&mirror), 1),
+    ];
+    for (material, exact) in [
+        (
+            Material::Mirror {
+                reflectance: [rho; 3],
+            },
+            true,
+        ),
+        (
+            Material::Glossy {
+                reflectance: [rho; 3],
+                exponent: 2000.0,
+            },
+            false,
+        ),
+    ] {
+        let materials = [Material::Emissive { radiance: [l; 3] }, material];
+        let scene = Scene {
+            objects: &objects,
+            materials: &materials,
+            lights: &[],
+            camera: Camera {
+                eye: [0.0, 0.0, 2.5],
+                look_at: [0.0; 3],
+                up: [0.0, 1.0, 0.0],
+                vfov_deg: 90.0,
+                aperture_radius: 0.0,
+                focus_distance: 1.0,
+            },
+            background: [0.0; 3],
+        };
+        let settings = Settings {
+            width: 9,
+            height: 9,
+            spp: 16,
+            max_depth: 3,
+            ..Settings::default()
+        };
+        let px = render(&scene, settings, AccelChoice::default()).unwrap();
+        let centre = px[4 * 9 + 4];
+        let want = rho * l;
+        for c in centre {
+            if exact {
+                assert_eq!(c, want, "{} mirror: ρ·L exactly", S::NAME);
+            } else {
+                assert!(
+                    c <= want * (1.0 + 1e-6) && c > want * 0.999,
+                    "{} glossy: {c} vs {want}",
+                    S::NAME
+                );
+            }
+        }
+        // A corner pixel sees the wall directly: L.
+        assert_eq!(px[0], [l; 3]);
+        let none = render(
+            &scene,
+            Settings {
+                max_depth: 0,
+                ..settings
+            },
+            AccelChoice::default(),
+        );
+        assert_eq!(
+            none.unwrap()[4 * 9 + 4],
+            [0.0; 3],
+            "max_depth 0: no reflection"
+        );
+    }
+}
+
+#[test]
+fn known_answer_furnace() {
+    furnace_case::<f32>();
+    furnace_case::<I16F16>();
+}
+
+/// Mean of `f` over an `n × n` grid of cell centres in `[0, 1)²`.
+fn grid_mean(n: u32, f: impl Fn(f32, f32) -> f64) -> f64 {
+    let mut sum = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            sum += f((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+        }
+    }
+    sum / f64::from(n * n)
+}
+
+#[test]
+fn warps_integrate_to_known_values() {
+    // Area-uniform disk: E[r²] = 1/2, E[x] = 0, every point inside.
+    let r2 = grid_mean(400, |u, v| {
+        let (x, y) = concentric_disk(u, v);
+        assert!(x * x + y * y <= 1.0 + 1e-6);
+        f64::from(x * x + y * y)
+    });
+    assert!((r2 - 0.5).abs() < 1e-4, "disk E[r²] = {r2}");
+    // Cosine-weighted hemisphere: E[cos θ] = 2/3.
+    let c = grid_mean(400, |u, v| f64::from(cosine_hemisphere(u, v).z));
+    assert!((c - 2.0 / 3.0).abs() < 1e-4, "cosine E[cos] = {c}");
+    // Phong lobe of exponent n: E[cos θ] = (n+1)/(n+2).
+    for n in [1.0f32, 10.0, 100.0] {
+        let c = grid_mean(400, |u, v| f64::from(phong_lobe(u, v, n).z));
+        let want = f64::from(n + 1.0) / f64::from(n + 2.0);
+        assert!(
+            (c - want).abs() < 1e-4,
+            "phong {n}: E[cos] = {c}, want {want}"
+        );
+    }
+    // Uniform cone: E[cos θ] = (1 + cos_max)/2; every direction inside the cone, unit length.
+    for cm in [0.0f32, 0.5, 0.99] {
+        let c = grid_mean(300, |u, v| {
+            let d = uniform_cone(u, v, cm);
+            assert!(d.z >= cm - 1e-6 && (d.length() - 1.0).abs() < 1e-5);
+            f64::from(d.z)
+        });
+        assert!(
+            (c - f64::from(1.0 + cm) / 2.0).abs() < 1e-4,
+            "cone {cm}: {c}"
+        );
+    }
+    // Tent: mean 0, variance 1/6, inside (-1, 1).
+    let m = grid_mean(300, |u, _| f64::from(tent(u)));
+    let var = grid_mean(300, |u, _| f64::from(tent(u)).powi(2));
+    assert!(
+        m.abs() < 1e-6 && (var - 1.0 / 6.0).abs() < 1e-4,
+        "tent {m} {var}"
+    );
+    // Frames: to_world keeps unit vectors unit and maps +z to the normal.
+    for n in [
+        [0.0f32, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+        [0.6, 0.0, 0.8],
+        [0.0, -1.0, 0.0],
+    ] {
+        let n = glam::Vec3::from_array(n);
+        assert!((to_world(glam::Vec3::Z, n) - n).length() < 1e-6);
+        let d = to_world(glam::Vec3::new(0.6, 0.0, 0.8), n);
+        assert!((d.length() - 1.0).abs() < 1e-6 && (d.dot(n) - 0.8).abs() < 1e-6);
+    }
+}
+
+#[test]
+fn permute_is_a_bijection() {
+    for n in 1..300u32 {
+        for seed in [0u32, 1, 0xdead_beef, 12345] {
+            let mut seen = vec![false; n as usize];
+            for i in 0..n {
+                let j = permute(i, n, seed);
+                assert!(j < n && !seen[j as usize], "n {n} seed {seed}: {i} -> {j}");
+                seen[j as usize] = true;
+            }
+        }
+    }
+}
+
+/// Every elementary interval `[a/2^k, (a+1)/2^k) × [b/2^(m-k), (b+1)/2^(m-k))` holds exactly
+/// one of the points.
+fn is_02_net(points: &[(u32, u32)], m: u32) -> bool {
+    (0..=m).all(|k| {
+        let mut seen = vec![false; 1 << m];
+        points.iter().all(|&(x, y)| {
+            // The top k bits of x and the top m - k bits of y (u64 so shifts by 32 are defined).
+            let (x, y) = (u64::from(x), u64::from(y));
+            let cell = ((x >> (32 - k)) << (m - k) | (y >> (32 - (m - k)))) as usize;
+            !std::mem::replace(&mut seen[cell], true)
+        })
+    })
+}
+
+#[test]
+fn owen_scrambled_sobol_is_a_02_net_at_powers_of_two() {
+    for m in 1..=8u32 {
+        for seed in [1u32, 77, 0x1234_5678] {
+            let pts: Vec<(u32, u32)> = (0..1u32 << m)
+                .map(|i| {
+                    let j = owen_scramble(i, seed);
+                    (
+                        owen_scramble(sobol_0(j), seed ^ 0xa5a5),
+                        owen_scramble(sobol_1(j), seed ^ 0x5a5a),
+                    )
+                })
+                .collect();
+            assert!(is_02_net(&pts, m), "m {m} seed {seed}");
+        }
+    }
+}
+
+#[test]
+fn stratified_samples_fill_every_cell_once() {
+    for spp in [1u32, 4, 9, 16, 64] {
+        let n = (spp as f32).sqrt() as u32;
+        for pixel in [0u32, 17, 4242] {
+            for pair in 0..3 {
+                let mut seen = vec![false; spp as usize];
+                for s in 0..spp {
+                    let mut st = SampleStream::new(SamplerKind::Stratified, pixel, s, spp, 9);
+                    for _ in 0..pair {
+                        st.next_2d();
+                    }
+                    let (u, v) = st.next_2d();
+                    assert!((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v));
+                    let cell = (v * n as f32) as usize * n as usize + (u * n as f32) as usize;
+                    assert!(
+                        !std::mem::replace(&mut seen[cell], true),
+                        "spp {spp} pair {pair}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Converts a built-in scene into the mode and hands it to `f`.
+fn with_scene<S: SpawnScalar, R>(d: &SceneData<'_>, f: impl FnOnce(&Scene<'_, S>) -> R) -> R {
+    let mut t = vec![Triangle::<S>::from_f32([[0.0; 3]; 3]).unwrap(); d.triangles.len()];
+    let mut s = vec![sphere::<S>([0.0; 3], 0.0); d.spheres.len()];
+    d.triangles_into(&mut t).unwrap();
+    d.spheres_into(&mut s).unwrap();
+    let mut o = vec![Object::new(Shape::Triangles(&[]), 0); d.objects.len()];
+    let scene = d.scene(&t, &s, &mut o).unwrap();
+    f(&scene)
+}
+
+fn tiles_equal_whole<S: SpawnScalar>(d: &SceneData<'_>) {
+    with_scene::<S, _>(d, |scene| {
+        let st = d.settings;
+        let whole = render(scene, st, AccelChoice::default()).unwrap();
+        let (n, i) = memory_needed(scene.objects);
+        let mut nodes = vec![Node::EMPTY; n];
+        let mut ids = vec![0u32; i];
+        let r = Renderer::new(scene, st, AccelChoice::default(), &mut nodes, &mut ids).unwrap();
+        // Odd tiles, rendered bottom-right first.
+        let mut tiled = vec![[0.0f32; 3]; whole.len()];
+        let (tw, th) = (7u32, 5u32);
+        let mut tiles = Vec::new();
+        for y in (0..st.height).step_by(th as usize) {
+            for x in (0..st.width).step_by(tw as usize) {
+                tiles.push(Tile {
+                    x,
+                    y,
+                    width: tw.min(st.width - x),
+                    height: th.min(st.height - y),
+                });
+            }
+        }
+        for t in tiles.iter().rev() {
+            let mut buf = vec![[0.0f32; 3]; (t.width * t.height) as usize];
+            r.render_tile(*t, &mut buf).unwrap();
+            for (k, px) in buf.iter().enumerate() {
+                let (x, y) = (t.x + k as u32 % t.width, t.y + k as u32 / t.width);
+                tiled[(y * st.width + x) as usize] = *px;
+            }
+        }
+        let bits = |v: &[[f32; 3]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&whole), bits(&tiled), "{} {}", d.name, S::NAME);
+        // Brute force gives the same bits.
+        let linear = render(scene, st, AccelChoice::Linear).unwrap();
+        assert_eq!(bits(&whole), bits(&linear), "{} {} linear", d.name, S::NAME);
+    });
+}
+
+#[test]
+fn tiles_in_any_order_equal_the_whole_image() {
+    for d in scenes::ALL {
+        tiles_equal_whole::<f32>(&d);
+        tiles_equal_whole::<I16F16>(&d);
+    }
+}
+
+#[test]
+fn plans_follow_the_scenes() {
+    let plan = |d: &SceneData<'_>| {
+        with_scene::<f32, _>(d, |scene| {
+            let (n, i) = memory_needed(scene.objects);
+            let mut nodes = vec![Node::EMPTY; n];
+            let mut ids = vec![0u32; i];
+            let plan = *Renderer::new(
+                scene,
+                d.settings,
+                AccelChoice::default(),
+                &mut nodes,
+                &mut ids,
+            )
+            .unwrap()
+            .plan();
+            plan
+        })
+    };
+    let c = plan(&scenes::CORNELL);
+    assert!(!c.pixel_centre && c.lens && c.motion && c.reflections && c.glossy);
+    assert_eq!((c.point_lights, c.area_lights, c.max_depth), (0, 1, 4));
+    let s = plan(&scenes::SPHERES);
+    assert!(!s.lens && !s.motion && s.reflections && !s.glossy);
+    assert_eq!((s.point_lights, s.area_lights), (2, 0));
+    // Nothing needed: one spp, pinhole, static, diffuse only.
+    let bare = SceneData {
+        settings: Settings {
+            spp: 1,
+            ..scenes::SPHERES.settings
+        },
+        materials: &[Material::Diffuse { albedo: [0.5; 3] }; 4],
+        ..scenes::SPHERES
+    };
+    let b = plan(&bare);
+    assert!(b.pixel_centre && !b.lens && !b.motion && !b.reflections && b.max_depth == 0);
+    let text = b.to_string();
+    assert!(
+        text.contains("anti-aliasing off") && text.contains("reflections off"),
+        "{text}"
+    );
+}
+
+/// A valid one-object scene to corrupt field by field.
+fn check_error(
+    objects: &[Object<'_, f32>],
+    materials: &[Material],
+    lights: &[Light],
+    camera: Camera,
+    settings: Settings,
+) -> SceneError {
+    let scene = Scene {
+        objects,
+        materials,
+        lights,
+        camera,
+        background: [0.0; 3],
+    };
+    render(&scene, settings, AccelChoice::default()).unwrap_err()
+}
+
+#[test]
+fn bad_scene_data_gives_typed_errors() {
+    let t = tris::<f32>(&floor(1.0));
+    let good_obj = [Object::new(Shape::Triangles(&t), 0)];
+    let diffuse = [Material::Diffuse { albedo: [0.5; 3] }];
+    let cam = narrow_camera([0.0, 2.0, 1.0]);
+    let st = Settings {
+        width: 2,
+        height: 2,
+        spp: 1,
+        ..Settings::default()
+    };
+    let e = |item, index, field, problem| SceneError {
+        item,
+        index,
+        field,
+        problem,
+    };
+    let point = [Light::Point {
+        position: [0.0, 1.0, 0.0],
+        intensity: [1.0; 3],
+    }];
+    // Object material out of range.
+    let obj = [Object::new(Shape::Triangles(&t), 3)];
+    assert_eq!(
+        check_error(&obj, &diffuse, &point, cam, st),
+        e(Item::Object, 0, "material", Problem::Index { len: 1 })
+    );
+    // Reflectance above one, negative, NaN; glossy exponent below one.
+    for (m, field, p) in [
+        (
+            Material::Diffuse {
+                albedo: [1.5, 0.0, 0.0],
+            },
+            "albedo",
+            Problem::AboveOne,
+        ),
+        (
+            Material::Mirror {
+                reflectance: [0.5, -0.1, 0.0],
+            },
+            "reflectance",
+            Problem::Negative,
+        ),
+        (
+            Material::Emissive {
+                radiance: [f32::NAN, 0.0, 0.0],
+            },
+            "radiance",
+            Problem::NonFinite,
+        ),
+        (
+            Material::Glossy {
+                reflectance: [0.5; 3],
+                exponent: 0.5,
+            },
+            "exponent",
+            Problem::OutOfRange {
+                min: 1.0,
+                max: f32::MAX,
+            },
+        ),
+    ] {
+        assert_eq!(
+            check_error(&good_obj, &[m], &point, cam, st),
+            e(Item::Material, 0, field, p)
+        );
+    }
+    // Lights: zero-area rectangle, non-positive radius, negative intensity, out-of-range point.
+    for (l, field, p) in [
+        (
+            Light::Rect {
+                corner: [0.0; 3],
+                edge_u: [1.0, 0.0, 0.0],
+                edge_v: [2.0, 0.0, 0.0],
+                radiance: [1.0; 3],
+            },
+            "edge_v",
+            Problem::ZeroArea,
+        ),
+        (
+            Light::Sphere {
+                center: [0.0; 3],
+                radius: -1.0,
+                radiance: [1.0; 3],
+            },
+            "radius",
+            Problem::NotPositive,
+        ),
+        (
+            Light::Point {
+                position: [0.0; 3],
+                intensity: [-1.0, 0.0, 0.0],
+            },
+            "intensity",
+            Problem::Negative,
+        ),
+        (
+            Light::Point {
+                position: [f32::INFINITY, 0.0, 0.0],
+                intensity: [1.0; 3],
+            },
+            "position",
+            Problem::NonFinite,
+        ),
+    ] {
+        assert_eq!(
+            check_error(&good_obj, &diffuse, &[l], cam, st),
+            e(Item::Light, 0, field, p)
+        );
+    }
+    // Camera.
+    let bad_up = Camera {
+        up: [0.0, -1.0, -0.5],
+        ..cam
+    };
+    assert_eq!(
+        check_error(&good_obj, &diffuse, &point, bad_up, st),
+        e(Item::Camera, 0, "up", Problem::Degenerate)
+    );
+    let bad_fov = Camera {
+        vfov_deg: 180.0,
+        ..cam
+    };
+    assert_eq!(
+        check_error(&good_obj, &diffuse, &point, bad_fov, st),
+        e(
+            Item::Camera,
+            0,
+            "vfov_deg",
+            Problem::OutOfRange {
+                min: 0.0,
+                max: 180.0
+            }
+        )
+    );
+    let bad_focus = Camera {
+        aperture_radius: 0.1,
+        focus_distance: 0.0,
+        ..cam
+    };
+    assert_eq!(
+        check_error(&good_obj, &diffuse, &point, bad_focus, st),
+        e(Item::Camera, 0, "focus_distance", Problem::NotPositive)
+    );
+    let bad_eye = Camera {
+        eye: [f32::NAN, 0.0, 0.0],
+        ..cam
+    };
+    assert_eq!(
+        check_error(&good_obj, &diffuse, &point, bad_eye, st),
+        e(Item::Camera, 0, "eye", Problem::NonFinite)
+    );
+    // Settings.
+    assert_eq!(
+        check_error(&good_obj, &diffuse, &point, cam, Settings { spp: 0, ..st }),
+        e(Item::Settings, 0, "spp", Problem::NotPositive)
+    );
+    assert_eq!(
+        check_error(
+            &good_obj,
+            &diffuse,
+            &point,
+            cam,
+            Settings { width: 0, ..st }
+        ),
+        e(Item::Settings, 0, "width", Problem::NotPositive)
+    );
+    // Motion must be finite.
+    let moving = [Object {
+        motion: [f32::NAN, 0.0, 0.0],
+        ..good_obj[0]
+    }];
+    assert_eq!(
+        check_error(&moving, &diffuse, &point, cam, st),
+        e(Item::Object, 0, "motion", Problem::NonFinite)
+    );
+    // Too many objects and lights.
+    let many = vec![good_obj[0]; MAX_OBJECTS + 1];
+    assert_eq!(
+        check_error(&many, &diffuse, &point, cam, st).problem,
+        Problem::TooMany { max: MAX_OBJECTS }
+    );
+    let lights = vec![point[0]; MAX_LIGHTS + 1];
+    assert_eq!(
+        check_error(&good_obj, &diffuse, &lights, cam, st).problem,
+        Problem::TooMany { max: MAX_LIGHTS }
+    );
+}
+
+#[test]
+fn buffers_and_tiles_are_checked_exactly() {
+    let t = tris::<f32>(&floor(1.0));
+    let t2 = tris::<f32>(&floor(2.0));
+    let objects = [
+        Object::new(Shape::Triangles(&t), 0),
+        Object::new(Shape::Triangles(&t2), 0),
+    ];
+    let scene = Scene {
+        objects: &objects,
+        materials: &[Material::Diffuse { albedo: [0.5; 3] }],
+        lights: &[],
+        camera: narrow_camera([0.0, 2.0, 1.0]),
+        background: [0.0; 3],
+    };
+    let (n, i) = memory_needed(scene.objects);
+    assert_eq!((n, i), (8, 4));
+    let st = Settings {
+        width: 4,
+        height: 3,
+        spp: 1,
+        ..Settings::default()
+    };
+    let bvh = AccelChoice::Bvh(BuildOptions {
+        builder: BuilderKind::Median,
+        max_leaf_size: 1,
+    });
+    let mut nodes = vec![Node::EMPTY; n - 1];
+    let mut ids = vec![0u32; i];
+    let err = Renderer::new(&scene, st, bvh, &mut nodes, &mut ids).unwrap_err();
+    assert_eq!(
+        err.problem,
+        Problem::TooSmall {
+            needed: 8,
+            available: 7
+        }
+    );
+    assert_eq!(err.field, "nodes");
+    let mut nodes = vec![Node::EMPTY; n];
+    let mut ids = vec![0u32; i - 1];
+    let err = Renderer::new(&scene, st, bvh, &mut nodes, &mut ids).unwrap_err();
+    assert_eq!(
+        (err.field, err.problem),
+        (
+            "prim_ids",
+            Problem::TooSmall {
+                needed: 4,
+                available: 3
+            }
+        )
+    );
+    // Brute force needs no memory at all.
+    let r = Renderer::new(&scene, st, AccelChoice::Linear, &mut [], &mut []).unwrap();
+    let mut out = vec![0u8; 4 * 3 * 3];
+    r.render_srgb8(&mut out).unwrap();
+    let err = r.render_srgb8(&mut out[..35]).unwrap_err();
+    assert_eq!(
+        (err.item, err.field, err.problem),
+        (
+            Item::Tile,
+            "out",
+            Problem::TooSmall {
+                needed: 36,
+                available: 35
+            }
+        )
+    );
+    let outside = Tile {
+        x: 3,
+        y: 0,
+        width: 2,
+        height: 1,
+    };
+    assert_eq!(
+        r.render_tile_srgb8(outside, &mut out).unwrap_err().field,
+        "width"
+    );
+    let outside = Tile {
+        x: 0,
+        y: u32::MAX,
+        width: 1,
+        height: 2,
+    };
+    assert_eq!(
+        r.render_tile_srgb8(outside, &mut out).unwrap_err().field,
+        "height"
+    );
+    // The message names the item, field and problem.
+    assert_eq!(
+        err.to_string(),
+        "tile `out`: buffer too small: need 36 slots, have 35"
+    );
+}
+
+/// Rays leaving sphere surfaces (outward reflections and shadow rays) never hit their own
+/// sphere again: a camera ray grazing a grid of spheres at several scales sees no acne, i.e.
+/// a mirror sphere in an emissive box is `ρ·L` on every pixel it covers.
+fn no_sphere_acne<S: SpawnScalar>(scale: f32, offset: f32) {
+    let s = 3.0 * scale;
+    let cube = |o: f32| -> Vec<[[f32; 3]; 3]> {
+        let c = |x: f32, y: f32, z: f32| [x * s + o, y * s, z * s];
+        vec![
+            [c(-1.0, -1.0, -1.0), c(1.0, -1.0, -1.0), c(1.0, 1.0, -1.0)],
+            [c(-1.0, -1.0, -1.0), c(1.0, 1.0, -1.0), c(-1.0, 1.0, -1.0)],
+            [c(-1.0, -1.0, 1.0), c(1.0, 1.0, 1.0), c(1.0, -1.0, 1.0)],
+            [c(-1.0, -1.0, 1.0), c(-1.0, 1.0, 1.0), c(1.0, 1.0, 1.0)],
+            [c(-1.0, -1.0, -1.0), c(-1.0, 1.0, 1.0), c(-1.0, -1.0, 1.0)],
+            [c(-1.0, -1.0, -1.0), c(-1.0, 1.0, -1.0), c(-1.0, 1.0, 1.0)],
+            [c(1.0, -1.0, -1.0), c(1.0, -1.0, 1.0), c(1.0, 1.0, 1.0)],
+            [c(1.0, -1.0, -1.0), c(1.0, 1.0, 1.0), c(1.0, 1.0, -1.0)],
+            [c(-1.0, -1.0, -1.0), c(-1.0, -1.0, 1.0), c(1.0, -1.0, 1.0)],
+            [c(-1.0, -1.0, -1.0), c(1.0, -1.0, 1.0), c(1.0, -1.0, -1.0)],
+            [c(-1.0, 1.0, -1.0), c(1.0, 1.0, 1.0), c(-1.0, 1.0, 1.0)],
+            [c(-1.0, 1.0, -1.0), c(1.0, 1.0, -1.0), c(1.0, 1.0, 1.0)],
+        ]
+    };
+    let t = tris::<S>(&cube(offset));
+    let sp = [sphere::<S>([offset, 0.0, 0.0], scale)];
+    let objects = [
+        Object::new(Shape::Triangles(&t), 0),
+        Object::new(Shape::Spheres(&sp), 1),
+    ];
+    let materials = [
+        Material::Emissive { radiance: [1.0; 3] },
+        Material::Mirror {
+            reflectance: [0.5; 3],
+        },
+    ];
+    let scene = Scene {
+        objects: &objects,
+        materials: &materials,
+        lights: &[],
+        camera: Camera {
+            eye: [offset, 0.0, 2.5 * scale],
+            look_at: [offset, 0.0, 0.0],
+            up: [0.0, 1.0, 0.0],
+            vfov_deg: 50.0,
+            aperture_radius: 0.0,
+            focus_distance: 1.0,
+        },
+        background: [0.0; 3],
+    };
+    let st = Settings {
+        width: 48,
+        height: 48,
+        spp: 1,
+        max_depth: 1,
+        ..Settings::default()
+    };
+    let px = render(&scene, st, AccelChoice::default()).unwrap();
+    let bad = px
+        .iter()
+        .filter(|p| **p != [1.0; 3] && **p != [0.5; 3])
+        .count();
+    assert_eq!(bad, 0, "{} scale {scale} offset {offset}", S::NAME);
+}
+
+#[test]
+fn spheres_leave_their_surface_cleanly() {
+    for (scale, offset) in [
+        (1.0, 0.0),
+        (0.01, 0.0),
+        (100.0, 0.0),
+        (1.0, 1000.0),
+        (0.01, 10.0),
+    ] {
+        no_sphere_acne::<f32>(scale, offset);
+    }
+    for (scale, offset) in [(1.0, 0.0), (0.05, 0.0), (100.0, 0.0), (1.0, 4000.0)] {
+        no_sphere_acne::<I16F16>(scale, offset);
+    }
+}
