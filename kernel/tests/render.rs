@@ -22,9 +22,7 @@ fn render<S: SpawnScalar>(
     settings: Settings,
     accel: AccelChoice,
 ) -> Result<Vec<[f32; 3]>, SceneError> {
-    let (n, i) = memory_needed(scene.objects);
-    let mut nodes = vec![Node::EMPTY; n];
-    let mut ids = vec![0u32; i];
+    let (mut nodes, mut ids) = buffers(scene);
     let r = Renderer::new(scene, settings, accel, &mut nodes, &mut ids)?;
     let mut out = vec![[0.0f32; 3]; (settings.width * settings.height) as usize];
     let tile = Tile {
@@ -35,6 +33,38 @@ fn render<S: SpawnScalar>(
     };
     r.render_tile(tile, &mut out)?;
     Ok(out)
+}
+
+/// The closed cube `[-half, half]³` moved by `x_offset` along x, two triangles per face.
+fn cube(half: f32, x_offset: f32) -> Vec<[[f32; 3]; 3]> {
+    let mut out = Vec::new();
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let corner = |u: f32, v: f32| {
+                let mut p = [0.0; 3];
+                p[axis] = sign * half;
+                p[(axis + 1) % 3] = u * half;
+                p[(axis + 2) % 3] = v * half;
+                p[0] += x_offset;
+                p
+            };
+            let q = [
+                corner(-1.0, -1.0),
+                corner(1.0, -1.0),
+                corner(1.0, 1.0),
+                corner(-1.0, 1.0),
+            ];
+            out.push([q[0], q[1], q[2]]);
+            out.push([q[0], q[2], q[3]]);
+        }
+    }
+    out
+}
+
+/// Node and id buffers of the size [`memory_needed`] gives.
+fn buffers<S: SpawnScalar>(scene: &Scene<'_, S>) -> (Vec<Node<S>>, Vec<u32>) {
+    let (n, i) = memory_needed(scene.objects);
+    (vec![Node::EMPTY; n], vec![0u32; i])
 }
 
 fn tris<S: SpawnScalar>(t: &[[[f32; 3]; 3]]) -> Vec<Triangle<S>> {
@@ -205,28 +235,7 @@ fn known_answer_rect_light() {
 /// reflectance `ρ` shows exactly `ρ·L`; a glossy sphere at most `ρ·L`, and `ρ·L` wherever no
 /// lobe sample falls below the surface; with no bounces left, a mirror is black.
 fn furnace_case<S: SpawnScalar>() {
-    let s = 3.0f32;
-    let corners = |x: f32, y: f32, z: f32| [x * s, y * s, z * s];
-    // The six faces of a cube.
-    let mut box_tris = Vec::new();
-    for axis in 0..3 {
-        for sign in [-1.0f32, 1.0] {
-            let mut q = [[0.0f32; 3]; 4];
-            for (k, (u, v)) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-                .iter()
-                .enumerate()
-            {
-                let mut p = [0.0; 3];
-                p[axis] = sign;
-                p[(axis + 1) % 3] = *u;
-                p[(axis + 2) % 3] = *v;
-                q[k] = corners(p[0], p[1], p[2]);
-            }
-            box_tris.push([q[0], q[1], q[2]]);
-            box_tris.push([q[0], q[2], q[3]]);
-        }
-    }
-    let t = tris::<S>(&box_tris);
+    let t = tris::<S>(&cube(3.0, 0.0));
     let mirror = [sphere::<S>([0.0, 0.0, 0.0], 1.0)];
     let (rho, l) = (0.8f32, 1.5f32);
     let objects = [
@@ -459,9 +468,7 @@ fn tiles_equal_whole<S: SpawnScalar>(d: &SceneData<'_>) {
     with_scene::<S, _>(d, |scene| {
         let st = d.settings;
         let whole = render(scene, st, AccelChoice::default()).unwrap();
-        let (n, i) = memory_needed(scene.objects);
-        let mut nodes = vec![Node::EMPTY; n];
-        let mut ids = vec![0u32; i];
+        let (mut nodes, mut ids) = buffers(scene);
         let r = Renderer::new(scene, st, AccelChoice::default(), &mut nodes, &mut ids).unwrap();
         // Odd tiles, rendered bottom-right first.
         let mut tiled = vec![[0.0f32; 3]; whole.len()];
@@ -505,9 +512,7 @@ fn tiles_in_any_order_equal_the_whole_image() {
 fn plans_follow_the_scenes() {
     let plan = |d: &SceneData<'_>| {
         with_scene::<f32, _>(d, |scene| {
-            let (n, i) = memory_needed(scene.objects);
-            let mut nodes = vec![Node::EMPTY; n];
-            let mut ids = vec![0u32; i];
+            let (mut nodes, mut ids) = buffers(scene);
             let plan = *Renderer::new(
                 scene,
                 d.settings,
@@ -850,25 +855,7 @@ fn buffers_and_tiles_are_checked_exactly() {
 /// sphere again: a camera ray grazing a grid of spheres at several scales sees no acne, i.e.
 /// a mirror sphere in an emissive box is `ρ·L` on every pixel it covers.
 fn no_sphere_acne<S: SpawnScalar>(scale: f32, offset: f32) {
-    let s = 3.0 * scale;
-    let cube = |o: f32| -> Vec<[[f32; 3]; 3]> {
-        let c = |x: f32, y: f32, z: f32| [x * s + o, y * s, z * s];
-        vec![
-            [c(-1.0, -1.0, -1.0), c(1.0, -1.0, -1.0), c(1.0, 1.0, -1.0)],
-            [c(-1.0, -1.0, -1.0), c(1.0, 1.0, -1.0), c(-1.0, 1.0, -1.0)],
-            [c(-1.0, -1.0, 1.0), c(1.0, 1.0, 1.0), c(1.0, -1.0, 1.0)],
-            [c(-1.0, -1.0, 1.0), c(-1.0, 1.0, 1.0), c(1.0, 1.0, 1.0)],
-            [c(-1.0, -1.0, -1.0), c(-1.0, 1.0, 1.0), c(-1.0, -1.0, 1.0)],
-            [c(-1.0, -1.0, -1.0), c(-1.0, 1.0, -1.0), c(-1.0, 1.0, 1.0)],
-            [c(1.0, -1.0, -1.0), c(1.0, -1.0, 1.0), c(1.0, 1.0, 1.0)],
-            [c(1.0, -1.0, -1.0), c(1.0, 1.0, 1.0), c(1.0, 1.0, -1.0)],
-            [c(-1.0, -1.0, -1.0), c(-1.0, -1.0, 1.0), c(1.0, -1.0, 1.0)],
-            [c(-1.0, -1.0, -1.0), c(1.0, -1.0, 1.0), c(1.0, -1.0, -1.0)],
-            [c(-1.0, 1.0, -1.0), c(1.0, 1.0, 1.0), c(-1.0, 1.0, 1.0)],
-            [c(-1.0, 1.0, -1.0), c(1.0, 1.0, -1.0), c(1.0, 1.0, 1.0)],
-        ]
-    };
-    let t = tris::<S>(&cube(offset));
+    let t = tris::<S>(&cube(3.0 * scale, offset));
     let sp = [sphere::<S>([offset, 0.0, 0.0], scale)];
     let objects = [
         Object::new(Shape::Triangles(&t), 0),

@@ -164,11 +164,11 @@ impl SpawnScalar for I16F16 {
     }
 }
 
-fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+pub(crate) fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
-fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+pub(crate) fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
@@ -182,17 +182,21 @@ fn sign(x: f64) -> i32 {
     }
 }
 
-fn normal_f64(v: &[[f64; 3]; 3]) -> [f64; 3] {
-    let e1 = sub(&v[1], &v[0]);
-    let e2 = sub(&v[2], &v[0]);
+pub(crate) fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     [
-        e1[1] * e2[2] - e1[2] * e2[1],
-        e1[2] * e2[0] - e1[0] * e2[2],
-        e1[0] * e2[1] - e1[1] * e2[0],
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
     ]
 }
 
-fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
+/// `(v1 − v0) × (v2 − v0)`.
+fn normal_f64(v: &[[f64; 3]; 3]) -> [f64; 3] {
+    cross(&sub(&v[1], &v[0]), &sub(&v[2], &v[0]))
+}
+
+/// `v / |v|`, scaled first so tiny and huge vectors normalise; `None` for zero or non-finite.
+pub(crate) fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
     let m = libm::fmax(
         libm::fabs(v[0]),
         libm::fmax(libm::fabs(v[1]), libm::fabs(v[2])),

@@ -17,7 +17,7 @@ use super::{AccelChoice, SceneError};
 use crate::accel::bvh::{nodes_needed, Bvh, Node};
 use crate::accel::{Accel, Counters, Linear};
 use crate::error::BuildError;
-use crate::geom::spawn::{self, SpawnScalar, MAX_NUDGES};
+use crate::geom::spawn::{self, cross, sub, unit, SpawnScalar, MAX_NUDGES};
 use crate::geom::{closer, Aabb, Hit, Primitive, Ray, Sphere, Triangle};
 use crate::render::scene::{Item, Light, Problem};
 use crate::scalar::Scalar;
@@ -98,6 +98,23 @@ fn build_index<'a, S: Scalar, P: Primitive<S>>(
 enum ShapeIndex<'a, S: Scalar> {
     Triangles(Index<'a, S, Triangle<S>>),
     Spheres(Index<'a, S, Sphere<S>>),
+}
+
+impl<S: Scalar> ShapeIndex<'_, S> {
+    #[inline]
+    fn intersect<C: Counters>(&self, ray: &Ray<S>, c: &mut C) -> Option<Hit<S>> {
+        match self {
+            Self::Triangles(a) => a.intersect(ray, c),
+            Self::Spheres(a) => a.intersect(ray, c),
+        }
+    }
+    #[inline]
+    fn occluded<C: Counters>(&self, ray: &Ray<S>, c: &mut C) -> bool {
+        match self {
+            Self::Triangles(a) => a.occluded(ray, c),
+            Self::Spheres(a) => a.occluded(ray, c),
+        }
+    }
 }
 
 /// An object ready for queries.
@@ -260,17 +277,29 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
         Ok(geo)
     }
 
-    /// The ray moved into object `o`'s frame at shutter time `time`, if it is not static.
-    /// `None` if the shifted origin leaves the mode's range (the object is then missed).
-    fn object_ray(o: &ObjectGeom<'_, S>, ray: &Ray<S>, time: f32) -> Option<Ray<S>> {
-        match o.motion {
-            None => Some(*ray),
-            Some(m) => {
-                let d = displacement::<S>(m, time);
-                let origin = shifted(S::vec_to_array(ray.origin()), d, -1.0);
-                ray.moved(origin).ok()
-            }
-        }
+    /// Runs `query` on object `o` for `ray` at shutter time `time`. A static object sees the
+    /// ray itself; a moving one is culled by its swept box first, then sees the ray moved into
+    /// its frame (and is missed if the moved origin leaves the mode's range).
+    #[inline]
+    fn query_object<C: Counters, R>(
+        o: &ObjectGeom<'a, S>,
+        ray: &Ray<S>,
+        time: f32,
+        c: &mut C,
+        query: impl FnOnce(&ShapeIndex<'a, S>, &Ray<S>, &mut C) -> R,
+    ) -> Option<R> {
+        let Some(m) = o.motion else {
+            return Some(query(&o.index, ray, c));
+        };
+        c.node();
+        o.swept.slab(ray)?;
+        let origin = shifted(
+            S::vec_to_array(ray.origin()),
+            displacement::<S>(m, time),
+            -1.0,
+        );
+        let moved = ray.moved(origin).ok()?;
+        Some(query(&o.index, &moved, c))
     }
 
     /// Closest hit at shutter time `time`; ties to the lowest global id.
@@ -286,19 +315,7 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
             let Ok(r) = ray.with_interval(ray.t_min(), best_t) else {
                 continue;
             };
-            if o.motion.is_some() {
-                c.node();
-                if o.swept.slab(&r).is_none() {
-                    continue;
-                }
-            }
-            let Some(r) = Self::object_ray(o, &r, time) else {
-                continue;
-            };
-            let h = match &o.index {
-                ShapeIndex::Triangles(a) => a.intersect(&r, c),
-                ShapeIndex::Spheres(a) => a.intersect(&r, c),
-            };
+            let h = Self::query_object(o, &r, time, c, ShapeIndex::intersect).flatten();
             if let Some(h) = h {
                 let id = o.base.saturating_add(h.prim);
                 if best.is_none_or(|b| closer(h.t, id, best_t, b.hit.prim)) {
@@ -349,22 +366,13 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
 
     /// Any object hit in the ray's interval at shutter time `time` (lights cast no shadow).
     pub(crate) fn occluded<C: Counters>(&self, ray: &Ray<S>, time: f32, c: &mut C) -> bool {
-        self.objects.iter().any(|o| {
-            if o.motion.is_some() {
-                c.node();
-                if o.swept.slab(ray).is_none() {
-                    return false;
-                }
-            }
-            Self::object_ray(o, ray, time).is_some_and(|r| match &o.index {
-                ShapeIndex::Triangles(a) => a.occluded(&r, c),
-                ShapeIndex::Spheres(a) => a.occluded(&r, c),
-            })
-        })
+        self.objects
+            .iter()
+            .any(|o| Self::query_object(o, ray, time, c, ShapeIndex::occluded) == Some(true))
     }
 
-    /// The world position, unit geometric normal (not yet facing the ray) of a hit, and the
-    /// origin for leaving the surface towards `toward` (any length, `f32`).
+    /// The point a hit lies on: world position, unit geometric normal (not yet facing the
+    /// ray), and what [`SurfacePoint::spawn_origin`] needs to leave it. `None` for lights.
     pub(crate) fn surface_point(
         &self,
         ray: &Ray<S>,
@@ -384,9 +392,7 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
                 let p: [f64; 3] = core::array::from_fn(|k| {
                     v[0][k] + u * (v[1][k] - v[0][k]) + w * (v[2][k] - v[0][k]) + d[k]
                 });
-                let e1 = sub(&v[1], &v[0]);
-                let e2 = sub(&v[2], &v[0]);
-                let n = unit64(cross(&e1, &e2))
+                let n = unit(cross(&sub(&v[1], &v[0]), &sub(&v[2], &v[0])))
                     .unwrap_or_else(|| S::ray_dir(ray.data()).map(|x| -x.to_f64()));
                 Some(SurfacePoint {
                     position: p,
@@ -403,7 +409,7 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
                 let dir = S::ray_dir(ray.data()).map(S::to_f64);
                 let t = h.hit.t.to_f64();
                 let q: [f64; 3] = core::array::from_fn(|k| o3[k] - d[k] + t * dir[k]);
-                let n = unit64(sub(&q, &c)).unwrap_or(dir.map(|x| -x));
+                let n = unit(sub(&q, &c)).unwrap_or(dir.map(|x| -x));
                 let r = sp.radius.to_f64();
                 // The point on the sphere along the normal: the offset is taken from there.
                 let p: [f64; 3] = core::array::from_fn(|k| c[k] + r * n[k] + d[k]);
@@ -448,8 +454,7 @@ impl<S: SpawnScalar> SurfacePoint<'_, S> {
     /// on `toward`'s side by the spawn rule of [`crate::spawn`], checked in the object's frame
     /// after the motion shift (so the object's own test sees it on the right side).
     pub(crate) fn spawn_origin(&self, toward: [f32; 3]) -> [S; 3] {
-        // Scale so fixed point keeps the direction's precision (a power of two: exact in f32).
-        let dir_s = S::array_to_vec(toward.map(|x| S::from_f32_saturating(x * 1024.0)));
+        let dir_s = dir_in_mode::<S>(toward);
         match self.prim {
             Prim::Triangle(tri, u, v) => {
                 let local = spawn::offset_origin(tri, u, v, dir_s);
@@ -495,6 +500,12 @@ impl<S: SpawnScalar> SurfacePoint<'_, S> {
             }
         }
     }
+}
+
+/// A direction in the mode, scaled by 1024 so fixed point keeps its precision (ray
+/// constructors normalise; the scale is a power of two, exact in `f32`).
+pub(crate) fn dir_in_mode<S: Scalar>(d: [f32; 3]) -> S::Vec3 {
+    S::array_to_vec(d.map(|x| S::from_f32_saturating(x * 1024.0)))
 }
 
 fn dominant(n: [f32; 3]) -> usize {
@@ -567,7 +578,7 @@ fn light_geom<S: Scalar>(l: &Light) -> Result<LightGeom<S>, (&'static str, Probl
                 return Err(("edge_v", Problem::NonFinite));
             }
             let n = cross(&edge_u.map(f64::from), &edge_v.map(f64::from));
-            let Some(n) = unit64(n) else {
+            let Some(n) = unit(n) else {
                 return Err(("edge_v", Problem::ZeroArea));
             };
             let add = |a: [f32; 3], b: [f32; 3]| core::array::from_fn(|k| a[k] + b[k]);
@@ -613,30 +624,4 @@ pub(crate) fn point_problem(e: crate::error::PointError) -> Problem {
         },
         crate::error::PointError::NegativeRadius => Problem::Negative,
     }
-}
-
-pub(crate) fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-pub(crate) fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-/// `v / |v|`, scaled first so tiny and huge vectors normalise; `None` for zero or non-finite.
-pub(crate) fn unit64(v: [f64; 3]) -> Option<[f64; 3]> {
-    let m = libm::fmax(
-        libm::fabs(v[0]),
-        libm::fmax(libm::fabs(v[1]), libm::fabs(v[2])),
-    );
-    if !(m > 0.0 && m.is_finite()) {
-        return None;
-    }
-    let s = v.map(|x| x / m);
-    let l = libm::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-    Some(s.map(|x| x / l))
 }

@@ -2,7 +2,7 @@
 //! reflection rays at mirror and glossy ones. Iterative; each step does only what the render
 //! plan says the scene needs.
 
-use super::geometry::{Surface, SurfacePoint};
+use super::geometry::{dir_in_mode, Surface, SurfacePoint};
 use super::sampling::{phong_lobe, tent, to_world, uniform_cone, SampleStream};
 use super::scene::{Filter, Light, Material};
 use super::{RenderPlan, RenderStats, Renderer};
@@ -54,39 +54,44 @@ pub(crate) fn sample_radiance<S: SpawnScalar>(
             }
             Surface::Object { object, .. } => object,
         };
-        let Some(sp) = r.geometry.surface_point(&ray, &hit, time) else {
-            break;
-        };
         let material = r
             .geometry
             .objects
             .get(object)
             .and_then(|o| r.materials.get(o.material as usize));
-        let n = Vec3::from_array(sp.normal);
-        // Two-sided surfaces: shade with the normal facing the incoming ray.
-        let nf = if n.dot(dir) > 0.0 { -n } else { n };
-        match material {
+        // Emitters end the path: no surface point needed.
+        let material = match material {
             None => break,
             Some(Material::Emissive { radiance: e }) => {
                 radiance += throughput * Vec3::from_array(*e);
                 break;
             }
-            Some(Material::Diffuse { albedo }) => {
+            Some(m) => m,
+        };
+        let Some(sp) = r.geometry.surface_point(&ray, &hit, time) else {
+            break;
+        };
+        let n = Vec3::from_array(sp.normal);
+        // Two-sided surfaces: shade with the normal facing the incoming ray.
+        let nf = if n.dot(dir) > 0.0 { -n } else { n };
+        match material {
+            Material::Emissive { .. } => break, // ended the path above
+            Material::Diffuse { albedo } => {
                 let e = direct_light(r, &sp, nf, time, stream, stats);
                 radiance += throughput * Vec3::from_array(*albedo) * (e * FRAC_1_PI);
                 break;
             }
-            Some(Material::Mirror { reflectance }) => {
+            Material::Mirror { reflectance } => {
                 if depth >= plan.max_depth {
                     break;
                 }
                 throughput *= Vec3::from_array(*reflectance);
                 dir = reflect(dir, nf);
             }
-            Some(Material::Glossy {
+            Material::Glossy {
                 reflectance,
                 exponent,
-            }) => {
+            } => {
                 if depth >= plan.max_depth {
                     break;
                 }
@@ -105,18 +110,13 @@ pub(crate) fn sample_radiance<S: SpawnScalar>(
         }
         let origin = sp.spawn_origin(dir.to_array());
         stats.reflection_rays += 1;
-        let Ok(next) = Ray::<S>::new(S::array_to_vec(origin), dir_in_mode::<S>(dir)) else {
+        let Ok(next) = Ray::<S>::new(S::array_to_vec(origin), dir_in_mode::<S>(dir.to_array()))
+        else {
             break;
         };
         ray = next;
     }
     radiance
-}
-
-/// A direction in the mode, scaled by 1024 so fixed point keeps its precision (the ray
-/// constructor normalises; the scale is a power of two, exact in `f32`).
-pub(crate) fn dir_in_mode<S: SpawnScalar>(d: Vec3) -> S::Vec3 {
-    S::array_to_vec(d.to_array().map(|x| S::from_f32_saturating(x * 1024.0)))
 }
 
 fn reflect(d: Vec3, n: Vec3) -> Vec3 {
@@ -254,7 +254,7 @@ fn visible<S: SpawnScalar>(
     ];
     let len = libm::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
     let dir = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32).normalize_or_zero();
-    let Ok(ray) = Ray::<S>::new(S::array_to_vec(origin), dir_in_mode::<S>(dir)) else {
+    let Ok(ray) = Ray::<S>::new(S::array_to_vec(origin), dir_in_mode::<S>(dir.to_array())) else {
         // Origin and target coincide (or the origin left the range): count as lit.
         return true;
     };

@@ -35,7 +35,7 @@ use camera::CameraFrame;
 use core::fmt;
 use geometry::Geometry;
 use glam::Vec3;
-use sampling::SampleStream;
+use sampling::Sampler;
 
 /// Which accelerator every object is built into.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -189,6 +189,7 @@ pub struct Renderer<'a, S: SpawnScalar> {
     background: Rgb,
     camera: CameraFrame,
     settings: Settings,
+    sampler: Sampler,
     plan: RenderPlan,
 }
 
@@ -221,6 +222,7 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
             background: scene.background,
             camera,
             settings,
+            sampler: Sampler::new(settings.sampler, settings.spp, settings.seed),
             plan: RenderPlan::derive(scene, &settings),
         })
     }
@@ -241,14 +243,14 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
     /// outside the image are rendered as if the image extended there).
     #[must_use]
     pub fn pixel(&self, x: u32, y: u32, stats: &mut RenderStats) -> Rgb {
-        let s = &self.settings;
-        let index = y.wrapping_mul(s.width).wrapping_add(x);
+        let index = y.wrapping_mul(self.settings.width).wrapping_add(x);
+        let spp = self.settings.spp;
         let mut sum = Vec3::ZERO;
-        for k in 0..s.spp {
-            let mut stream = SampleStream::new(s.sampler, index, k, s.spp, s.seed);
+        for k in 0..spp {
+            let mut stream = self.sampler.stream(index, k);
             sum += integrator::sample_radiance(self, x, y, &mut stream, stats);
         }
-        (sum / s.spp as f32).to_array()
+        (sum / spp as f32).to_array()
     }
 
     /// Renders `tile` as linear RGB into `out` (row-major within the tile, `width·height`

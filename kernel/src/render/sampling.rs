@@ -130,6 +130,43 @@ pub fn permute(index: u32, n: u32, seed: u32) -> u32 {
     index
 }
 
+/// The per-render part of sampling: kind, sample count, seed, and the stratified grid derived
+/// from the sample count once (`cols = ⌈√spp⌉`, `rows = ⌈spp / cols⌉`).
+#[derive(Clone, Copy, Debug)]
+pub struct Sampler {
+    kind: SamplerKind,
+    spp: u32,
+    seed: u32,
+    cols: u32,
+    rows: u32,
+}
+
+impl Sampler {
+    /// A sampler for `spp` samples per pixel.
+    #[must_use]
+    pub fn new(kind: SamplerKind, spp: u32, seed: u32) -> Self {
+        let cols = ceil_sqrt(spp);
+        Self {
+            kind,
+            spp,
+            seed,
+            cols,
+            rows: spp.div_ceil(cols).max(1),
+        }
+    }
+
+    /// The stream of sample `sample` of pixel `pixel` (a linear pixel index).
+    #[must_use]
+    pub const fn stream(&self, pixel: u32, sample: u32) -> SampleStream {
+        SampleStream {
+            sampler: *self,
+            pixel,
+            sample,
+            pair: 0,
+        }
+    }
+}
+
 /// The sample stream of one pixel sample: hands out dimension pairs in a fixed order.
 ///
 /// Dimension pairs are numbered from 0 in the order the renderer asks for them (pixel position,
@@ -137,44 +174,41 @@ pub fn permute(index: u32, n: u32, seed: u32) -> u32 {
 /// `(pixel, sample, pair, seed)`.
 #[derive(Clone, Copy, Debug)]
 pub struct SampleStream {
-    kind: SamplerKind,
+    sampler: Sampler,
     pixel: u32,
     sample: u32,
-    spp: u32,
-    seed: u32,
     pair: u32,
 }
 
 impl SampleStream {
-    /// The stream of sample `sample` (of `spp`) of pixel `pixel` (a linear pixel index).
+    /// The stream of sample `sample` (of `spp`) of pixel `pixel`. A renderer makes one
+    /// [`Sampler`] and calls [`Sampler::stream`] per sample instead.
     #[must_use]
-    pub const fn new(kind: SamplerKind, pixel: u32, sample: u32, spp: u32, seed: u32) -> Self {
-        Self {
-            kind,
-            pixel,
-            sample,
-            spp,
-            seed,
-            pair: 0,
-        }
+    pub fn new(kind: SamplerKind, pixel: u32, sample: u32, spp: u32, seed: u32) -> Self {
+        Sampler::new(kind, spp, seed).stream(pixel, sample)
     }
 
     /// The next dimension pair, in `[0, 1)²`.
     pub fn next_2d(&mut self) -> (f32, f32) {
+        let Sampler {
+            kind,
+            spp,
+            seed,
+            cols,
+            rows,
+        } = self.sampler;
         let pair = self.pair;
         self.pair = self.pair.wrapping_add(1);
-        let key = hash4(self.pixel, pair, self.seed, 0x5eed_0001);
-        match self.kind {
+        let key = hash4(self.pixel, pair, seed, 0x5eed_0001);
+        match kind {
             SamplerKind::Independent => {
-                let h = hash4(self.pixel, self.sample, pair, self.seed);
+                let h = hash4(self.pixel, self.sample, pair, seed);
                 (unit_float(h), unit_float(hash(h ^ 0x68e3_1da4)))
             }
             SamplerKind::Stratified => {
-                let cols = ceil_sqrt(self.spp);
-                let rows = self.spp.div_ceil(cols).max(1);
-                let cell = permute(self.sample, self.spp, key);
+                let cell = permute(self.sample, spp, key);
                 let (cx, cy) = (cell % cols, cell / cols);
-                let h = hash4(self.pixel, self.sample, pair, self.seed ^ 0x2545_f491);
+                let h = hash4(self.pixel, self.sample, pair, seed ^ 0x2545_f491);
                 let jx = unit_float(h);
                 let jy = unit_float(hash(h ^ 0x68e3_1da4));
                 (
