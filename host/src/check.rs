@@ -200,7 +200,7 @@ pub fn describe_differences(reports: &[CaseReport]) -> Vec<String> {
             r.differences.iter().map(move |(variant, d)| {
                 format!(
                     "{} ({}): {variant} differs from the kernel's render_srgb8: first at pixel \
-                     ({}, {}): expected {:?}, got {:?} ({} pixel{} differ)",
+                     ({}, {}): expected {:?}, got {:?} ({} {})",
                     r.scene,
                     r.mode,
                     d.x,
@@ -208,7 +208,11 @@ pub fn describe_differences(reports: &[CaseReport]) -> Vec<String> {
                     d.expected,
                     d.actual,
                     d.count,
-                    if d.count == 1 { "" } else { "s" }
+                    if d.count == 1 {
+                        "pixel differs"
+                    } else {
+                        "pixels differ"
+                    }
                 )
             })
         })

@@ -21,31 +21,11 @@ pub fn fnv1a64(bytes: &[u8]) -> u64 {
     })
 }
 
-/// The name of a render's hash line and PNG: `<scene>_<mode>`; the hash line is
-/// `render_<scene>_<mode>`.
+/// The name of a render's PNG, `<scene>_<mode>`; its line in the hash file is
+/// `render_<scene>_<mode>` (read with `cases.rs`'s `parse_golden`, the one parser of that file).
 #[must_use]
 pub fn snapshot_name(scene: &str, mode: &str) -> String {
     format!("{scene}_{mode}")
-}
-
-/// The `name = 0x…` lines of a hash file (`#` starts a comment).
-///
-/// # Errors
-/// The 1-based number of the first malformed line.
-pub fn parse_hashes(text: &str) -> Result<Vec<(String, u64)>, usize> {
-    let mut out = Vec::new();
-    for (i, raw) in text.lines().enumerate() {
-        let line = raw.split('#').next().unwrap_or_default().trim();
-        if line.is_empty() {
-            continue;
-        }
-        let (name, value) = line.split_once('=').ok_or(i + 1)?;
-        let value = value.trim();
-        let hex = value.strip_prefix("0x").ok_or(i + 1)?;
-        let v = u64::from_str_radix(hex, 16).map_err(|_| i + 1)?;
-        out.push((name.trim().to_string(), v));
-    }
-    Ok(out)
 }
 
 /// A golden image that does not match.
@@ -118,10 +98,14 @@ pub fn compare_with_png(
         Ok(exp) => match first_difference(exp, actual) {
             None => return Ok(()),
             Some(d) => format!(
-                "{}: {} pixel{} differ, first at ({}, {}): golden {:?}, render {:?}",
+                "{}: {} {}, first at ({}, {}): golden {:?}, render {:?}",
                 golden.display(),
                 d.count,
-                if d.count == 1 { "" } else { "s" },
+                if d.count == 1 {
+                    "pixel differs"
+                } else {
+                    "pixels differ"
+                },
                 d.x,
                 d.y,
                 d.expected,
@@ -165,13 +149,5 @@ mod tests {
         assert_eq!(fnv1a64(b""), 0xcbf2_9ce4_8422_2325);
         assert_eq!(fnv1a64(b"a"), 0xaf63_dc4c_8601_ec8c);
         assert_eq!(fnv1a64(b"foobar"), 0x8594_4171_f739_67e8);
-    }
-
-    #[test]
-    fn hash_lines_parse() {
-        let h = parse_hashes("# c\n\nrender_x_f32 = 0x00ff # t\n").unwrap();
-        assert_eq!(h, [("render_x_f32".to_string(), 0xff)]);
-        assert_eq!(parse_hashes("a 0x1\n"), Err(1));
-        assert_eq!(parse_hashes("a = 12\n"), Err(1));
     }
 }
