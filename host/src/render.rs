@@ -291,7 +291,7 @@ fn progress_bar(wanted: bool, s: &Settings, tiles: usize) -> ProgressBar {
         return ProgressBar::hidden();
     }
     let style = ProgressStyle::with_template(
-        "{spinner} rendering [{bar:40}] {pos}/{len} tiles, {elapsed} (eta {eta})",
+        "{spinner} rendering [{bar:30}] {pos}/{len} tiles, {elapsed} (eta {eta})",
     )
     .map_or_else(
         |_| ProgressStyle::default_bar(),
