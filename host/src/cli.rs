@@ -2,17 +2,24 @@
 //!
 //! Each command returns the JSON object `main` prints as the last line of stdout.
 
+use crate::check::{check_scene, describe_differences, CaseReport};
 use crate::classify::{classify, Classification};
 use crate::compare::{compare_hits, Comparison, DEFAULT_REL};
 use crate::error::Error;
 use crate::obj::load_obj;
 use crate::rayfile::{read_hits, read_rays, write_hits};
-use crate::render::{render, write_png, RenderConfig};
-use crate::scene::{CameraSource, Scene};
+use crate::render::{
+    accel_choice, accel_name, mode_name, plan, render, write_pfm, write_png, RenderError,
+    RenderOptions,
+};
+use crate::scene::{resolve_scene, DEFAULT_SCENE};
+use crate::scenefile::{write_scene_file, FilterName, SamplerName};
+use crate::spec::{SceneOrigin, SceneSpec};
 use crate::trace::{trace, AccelKind, Builder, Mode, TraceConfig};
 use clap::builder::RangedU64ValueParser;
 use clap::{Args, Parser, Subcommand};
 use raykernel::bvh::{BuildOptions, BuilderKind, MAX_LEAF_SIZE};
+use raykernel::render::{scenes, Settings};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -34,33 +41,88 @@ pub enum Command {
     /// --scene and --rays, also check each differing ray passes within quantization error of an
     /// edge of a reported triangle.
     CompareHits(CompareArgs),
-    /// Render a scene to a PNG: the built-in one, or an OBJ (camera from NAME.camera beside
-    /// it, or framed); one primary ray per pixel, Lambert shading, hard shadows.
+    /// Render a scene with the distribution ray tracer: a built-in scene (default `cornell`),
+    /// a scene file (.json, see docs/SCENE_FORMAT.md) or an OBJ mesh; PNG out, optionally
+    /// linear PFM; parallel over tiles.
     Render(RenderArgs),
+    /// Render scenes every way (kernel single-threaded, host tiles at several thread counts
+    /// and tile sizes, every accelerator) and check all are byte-identical.
+    Check(CheckArgs),
 }
 
-/// `host render [SCENE.obj] --out FILE.png [options]`.
+/// Settings a command line may override (scene or file settings otherwise).
+#[derive(Clone, Debug, Default, Args)]
+pub struct SettingsArgs {
+    /// Image width in pixels [default: the scene file's, else 512].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub width: Option<u32>,
+    /// Image height in pixels [default: the scene file's, else 512 (built-ins keep their
+    /// aspect ratio)].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub height: Option<u32>,
+    /// Samples per pixel [default: the scene file's, else 64].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub spp: Option<u32>,
+    /// Most reflection bounces [default: the scene's].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=64))]
+    pub max_depth: Option<u32>,
+    /// Sample placement [default: the scene's].
+    #[arg(long, value_enum)]
+    pub sampler: Option<SamplerName>,
+    /// Pixel filter [default: the scene's].
+    #[arg(long, value_enum)]
+    pub filter: Option<FilterName>,
+    /// Seed of every random value [default: the scene's].
+    #[arg(long)]
+    pub seed: Option<u32>,
+}
+
+impl SettingsArgs {
+    /// `base` with every given flag applied.
+    #[must_use]
+    pub fn apply(&self, base: Settings) -> Settings {
+        Settings {
+            width: self.width.unwrap_or(base.width),
+            height: self.height.unwrap_or(base.height),
+            spp: self.spp.unwrap_or(base.spp),
+            max_depth: self.max_depth.unwrap_or(base.max_depth),
+            sampler: self.sampler.map_or(base.sampler, Into::into),
+            filter: self.filter.map_or(base.filter, Into::into),
+            seed: self.seed.unwrap_or(base.seed),
+        }
+    }
+}
+
+/// `host render [SCENE] --out FILE.png [options]`.
 #[derive(Clone, Debug, Args)]
 pub struct RenderArgs {
-    /// An OBJ scene; without it, the built-in scene (generated, needs no files).
-    pub scene: Option<PathBuf>,
-    /// The PNG to write.
+    /// A built-in scene (cornell, spheres, motion), a scene file (.json) or an OBJ mesh (.obj,
+    /// camera from NAME.camera beside it or framed) [default: cornell].
+    pub scene: Option<String>,
+    /// The PNG to write (8-bit sRGB).
+    #[arg(long, required_unless_present_any = ["explain", "dump_scene"])]
+    pub out: Option<PathBuf>,
+    /// Also write the linear image (mean radiance per pixel, unclipped) as a PFM file.
+    #[arg(long, value_name = "FILE.pfm")]
+    pub linear: Option<PathBuf>,
+    /// Write the scene, with the settings this command would render it with, as a scene file.
+    #[arg(long, value_name = "FILE.json")]
+    pub dump_scene: Option<PathBuf>,
+    /// Print the render plan (what the kernel will do) and exit without rendering.
     #[arg(long)]
-    pub out: PathBuf,
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 640,
-          value_parser = clap::value_parser!(u32).range(1..=16384))]
-    pub width: u32,
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 480,
-          value_parser = clap::value_parser!(u32).range(1..=16384))]
-    pub height: u32,
-    /// Number mode of the kernel.
+    pub explain: bool,
+    /// Settings.
+    #[command(flatten)]
+    pub settings: SettingsArgs,
+    /// Number mode of the kernel's geometry.
     #[arg(long, value_enum, default_value_t = Mode::F32)]
     pub mode: Mode,
     /// Worker threads [default: the available parallelism].
     #[arg(long, value_parser = RangedU64ValueParser::<usize>::new().range(1..=1024))]
     pub threads: Option<usize>,
+    /// Accelerator of every object.
+    #[arg(long, value_enum, default_value_t = AccelKind::Bvh)]
+    pub accel: AccelKind,
     /// BVH builder.
     #[arg(long, value_enum, default_value_t = Builder::Sah)]
     pub builder: Builder,
@@ -68,71 +130,126 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 4,
           value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_LEAF_SIZE)))]
     pub leaf: u32,
+    /// Tile size in pixels (square tiles, rendered in parallel).
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub tile: u32,
+}
+
+/// `host check [SCENE...]`.
+#[derive(Clone, Debug, Args)]
+pub struct CheckArgs {
+    /// Scenes as for `host render` [default: every built-in scene].
+    pub scenes: Vec<String>,
+    /// Only this mode [default: both].
+    #[arg(long, value_enum)]
+    pub mode: Option<Mode>,
+    /// Settings [default: each scene's own].
+    #[command(flatten)]
+    pub settings: SettingsArgs,
 }
 
 /// The JSON report of `host render`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RenderReport {
-    /// `built-in` or the OBJ path.
+    /// Scene name.
     pub scene: String,
-    /// `built-in`, `framed`, or the `.camera` file.
-    pub camera: String,
-    /// PNG path.
-    pub out: String,
+    /// `built-in`, or the scene file or OBJ.
+    pub source: String,
+    /// PNG written, if any.
+    pub out: Option<String>,
+    /// PFM written, if any.
+    pub linear: Option<String>,
+    /// Scene file written, if any.
+    pub dump_scene: Option<String>,
     /// Width in pixels.
     pub width: u32,
     /// Height in pixels.
     pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
     /// `f32` or `fixed`.
     pub mode: &'static str,
-    /// BVH builder.
-    pub builder: &'static str,
-    /// Largest leaf.
-    pub leaf: u32,
-    /// Threads used.
-    pub threads: usize,
+    /// Accelerator: `linear` or `bvh BUILDER leaf N`.
+    pub accel: String,
     /// Triangles.
     pub triangles: usize,
-    /// BVH build time.
+    /// Spheres.
+    pub spheres: usize,
+    /// The render plan (what the kernel does).
+    pub plan: String,
+    /// Figures of the render (absent with `--explain` or a dump only).
+    #[serde(flatten)]
+    pub figures: Option<RenderFigures>,
+}
+
+/// Times and ray counts of a render.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RenderFigures {
+    /// Threads used.
+    pub threads: usize,
+    /// Tile size.
+    pub tile: u32,
+    /// Scene conversion and accelerator builds.
     pub build_ms: f64,
-    /// Render time (all pixels, all threads; no PNG encoding).
+    /// Rendering every tile (all threads; no encoding or file writes).
     pub render_ms: f64,
-    /// Primary rays.
-    pub primary_rays: u64,
+    /// Camera rays.
+    pub camera_rays: u64,
     /// Shadow rays.
     pub shadow_rays: u64,
-    /// Primary and shadow rays.
+    /// Reflection rays.
+    pub reflection_rays: u64,
+    /// Every ray.
     pub rays: u64,
     /// Million rays per second of render time.
     pub mrays_per_s: f64,
-    /// Primary rays that hit.
-    pub hits: u64,
 }
 
 impl RenderReport {
-    /// One line for people: size, time, rays, Mrays/s.
+    /// Lines for people: the plan, then what was rendered and how fast, or what was written.
     #[must_use]
     pub fn summary(&self) -> String {
-        format!(
-            "rendered {} ({} triangles) at {}x{}, {}, {} BVH, {} thread{}: build {:.1} ms, \
-             render {:.1} ms, {} rays ({} primary + {} shadow), {:.2} Mrays/s -> {}",
-            self.scene,
-            self.triangles,
-            self.width,
-            self.height,
-            self.mode,
-            self.builder,
-            self.threads,
-            if self.threads == 1 { "" } else { "s" },
-            self.build_ms,
-            self.render_ms,
-            self.rays,
-            self.primary_rays,
-            self.shadow_rays,
-            self.mrays_per_s,
-            self.out
-        )
+        let mut lines = vec![format!("plan: {}", self.plan)];
+        if let Some(f) = &self.figures {
+            let m = |n: u64| n as f64 / 1e6;
+            lines.push(format!(
+                "rendered {} at {}x{}, {} spp, {}, {}, {} thread{}: build {:.1} ms, render \
+                 {:.2} s, {:.1} M rays ({:.1} M camera + {:.1} M shadow + {:.1} M reflection), \
+                 {:.2} Mrays/s -> {}",
+                self.scene,
+                self.width,
+                self.height,
+                self.spp,
+                self.mode,
+                self.accel,
+                f.threads,
+                if f.threads == 1 { "" } else { "s" },
+                f.build_ms,
+                f.render_ms / 1e3,
+                m(f.rays),
+                m(f.camera_rays),
+                m(f.shadow_rays),
+                m(f.reflection_rays),
+                f.mrays_per_s,
+                self.out.as_deref().unwrap_or("-")
+            ));
+        }
+        if let Some(d) = &self.dump_scene {
+            lines.push(format!("wrote scene file {d}"));
+        }
+        lines.join("\n")
     }
+}
+
+/// The JSON report of `host check`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CheckReport {
+    /// One entry per scene and mode.
+    pub cases: Vec<CaseReport>,
+    /// Renders compared with their reference.
+    pub renders: usize,
+    /// Renders that differ.
+    pub differences: usize,
 }
 
 /// `host trace SCENE.obj RAYS --out HITS [options]`.
@@ -269,6 +386,15 @@ pub fn run(cli: &Cli) -> Result<String, Error> {
             let report = run_render(args)?;
             (Some(report.summary()), serde_json::to_string(&report))
         }
+        Command::Check(args) => {
+            let report = run_check(args)?;
+            let line = format!(
+                "check passed: {} renders of {} scene/mode cases identical to the kernel's",
+                report.renders,
+                report.cases.len()
+            );
+            (Some(line), serde_json::to_string(&report))
+        }
     };
     // Structs of numbers and strings always serialize; the fallback only avoids a panic path.
     let json = json.unwrap_or_else(|e| format!("{{\"error\":\"cannot encode report: {e}\"}}"));
@@ -278,53 +404,152 @@ pub fn run(cli: &Cli) -> Result<String, Error> {
     })
 }
 
-/// `host render`: load or generate the scene, render, write the PNG.
+/// Samples per pixel of `host render` for built-in scenes (their own settings are the small
+/// ones of the snapshot tests).
+pub const BUILT_IN_SPP: u32 = 64;
+/// Width of `host render` for built-in scenes; the height keeps the scene's aspect ratio.
+pub const BUILT_IN_WIDTH: u32 = 512;
+
+/// The settings `host render` uses for `spec` before command-line flags: a scene file's or an
+/// OBJ's own; for a built-in, 512 pixels wide (its aspect kept) at 64 spp.
+#[must_use]
+pub fn render_base_settings(spec: &SceneSpec) -> Settings {
+    let s = spec.settings;
+    match spec.origin {
+        SceneOrigin::BuiltIn => Settings {
+            width: BUILT_IN_WIDTH,
+            height: ((u64::from(BUILT_IN_WIDTH) * u64::from(s.height) + u64::from(s.width) / 2)
+                / u64::from(s.width.max(1)))
+            .clamp(1, 16384) as u32,
+            spp: BUILT_IN_SPP,
+            ..s
+        },
+        SceneOrigin::File(_) | SceneOrigin::Obj(_) => s,
+    }
+}
+
+fn render_error(spec: &SceneSpec, mode: Mode) -> impl Fn(RenderError) -> Error + '_ {
+    move |e| match e {
+        RenderError::Scene(e) => spec.explain(&e, mode_name(mode)),
+        RenderError::Pool(msg) => Error::Usage(format!("cannot start threads: {msg}")),
+    }
+}
+
+/// `host render`: load the scene, then dump it, explain the plan, or render and write images.
 ///
 /// # Errors
-/// A bad or unreadable OBJ or `.camera` file, a scene the mode cannot represent, a build the
-/// kernel refuses, or an unwritable output.
+/// An unknown scene, a bad or unreadable scene file, OBJ or `.camera` file, a scene the
+/// kernel rejects in the chosen mode, or an unwritable output.
 pub fn run_render(args: &RenderArgs) -> Result<RenderReport, Error> {
-    let scene = match &args.scene {
-        Some(path) => Scene::load(path, args.width, args.height)?,
-        None => Scene::built_in(),
+    let mut spec = resolve_scene(args.scene.as_deref().unwrap_or(DEFAULT_SCENE))?;
+    spec.settings = args.settings.apply(render_base_settings(&spec));
+    let settings = spec.settings;
+    let data = spec.data();
+    let mode = args.mode;
+    let accel = accel_choice(
+        args.accel,
+        BuildOptions {
+            builder: args.builder.into(),
+            max_leaf_size: args.leaf,
+        },
+    );
+    let the_plan = plan(&data, settings, mode).map_err(|e| spec.explain(&e, mode_name(mode)))?;
+    if let Some(path) = &args.dump_scene {
+        write_scene_file(path, &data, &spec.material_names)?;
+    }
+    let mut report = RenderReport {
+        scene: spec.name.clone(),
+        source: match &spec.origin {
+            SceneOrigin::BuiltIn => "built-in".into(),
+            SceneOrigin::File(p) | SceneOrigin::Obj(p) => p.display().to_string(),
+        },
+        out: None,
+        linear: None,
+        dump_scene: args.dump_scene.as_ref().map(|p| p.display().to_string()),
+        width: settings.width,
+        height: settings.height,
+        spp: settings.spp,
+        mode: mode_name(mode),
+        accel: accel_name(accel),
+        triangles: spec.triangles.len(),
+        spheres: spec.spheres.len(),
+        plan: the_plan.to_string(),
+        figures: None,
+    };
+    let Some(out) = args.out.as_ref().filter(|_| !args.explain) else {
+        return Ok(report);
     };
     let threads = args.threads.unwrap_or_else(|| {
         std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
     });
-    let config = RenderConfig {
-        width: args.width,
-        height: args.height,
-        mode: args.mode,
+    let options = RenderOptions {
+        mode,
+        accel,
         threads,
-        build: BuildOptions {
-            builder: args.builder.into(),
-            max_leaf_size: args.leaf,
-        },
+        tile: (args.tile, args.tile),
+        progress: true,
     };
-    let (image, stats) = render(&scene, &config)?;
-    write_png(&args.out, &image)?;
-    Ok(RenderReport {
-        scene: scene.name.clone(),
-        camera: match &scene.camera_source {
-            CameraSource::BuiltIn => "built-in".into(),
-            CameraSource::Framed => "framed".into(),
-            CameraSource::File(p) => p.display().to_string(),
+    let r = render(&data, settings, &options).map_err(render_error(&spec, mode))?;
+    write_png(out, &r.frame.srgb8())?;
+    if let Some(path) = &args.linear {
+        write_pfm(path, &r.frame)?;
+        report.linear = Some(path.display().to_string());
+    }
+    report.out = Some(out.display().to_string());
+    let rays = r.stats.rays();
+    report.figures = Some(RenderFigures {
+        threads,
+        tile: args.tile,
+        build_ms: r.build_ms,
+        render_ms: r.render_ms,
+        camera_rays: r.stats.camera_rays,
+        shadow_rays: r.stats.shadow_rays,
+        reflection_rays: r.stats.reflection_rays,
+        rays,
+        mrays_per_s: if r.render_ms > 0.0 {
+            rays as f64 / r.render_ms / 1e3
+        } else {
+            0.0
         },
-        out: args.out.display().to_string(),
-        width: args.width,
-        height: args.height,
-        mode: args.mode.name(),
-        builder: BuilderKind::from(args.builder).name(),
-        leaf: args.leaf,
-        threads: stats.threads,
-        triangles: stats.triangles,
-        build_ms: stats.build_ms,
-        render_ms: stats.render_ms,
-        primary_rays: stats.primary_rays,
-        shadow_rays: stats.shadow_rays,
-        rays: stats.rays(),
-        mrays_per_s: stats.mrays_per_s(),
-        hits: stats.hits,
+    });
+    Ok(report)
+}
+
+/// `host check`: every scene (default: every built-in) in each mode, every way of rendering,
+/// byte for byte.
+///
+/// # Errors
+/// A scene that cannot be loaded or rendered, or [`Error::Mismatch`] listing every render that
+/// differs (the first differing pixel and both values).
+pub fn run_check(args: &CheckArgs) -> Result<CheckReport, Error> {
+    let names: Vec<String> = if args.scenes.is_empty() {
+        scenes::ALL.iter().map(|s| s.name.to_string()).collect()
+    } else {
+        args.scenes.clone()
+    };
+    let modes = match args.mode {
+        Some(m) => vec![m],
+        None => vec![Mode::F32, Mode::Fixed],
+    };
+    let mut cases = Vec::new();
+    for name in &names {
+        let mut spec = resolve_scene(name)?;
+        spec.settings = args.settings.apply(spec.settings);
+        for &mode in &modes {
+            cases.push(check_scene(&spec, mode)?);
+        }
+    }
+    let lines = describe_differences(&cases);
+    if !lines.is_empty() {
+        return Err(Error::Mismatch(format!(
+            "check failed: {}",
+            lines.join("\ncheck failed: ")
+        )));
+    }
+    Ok(CheckReport {
+        renders: cases.iter().map(|c| c.compared).sum(),
+        differences: 0,
+        cases,
     })
 }
 

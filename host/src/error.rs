@@ -50,6 +50,25 @@ pub enum Error {
     },
     /// Arguments that parse but do not go together (exit code 2, like clap's).
     Usage(String),
+    /// A bad scene: unreadable or malformed scene file, or values the kernel rejects.
+    Scene {
+        /// The scene file (or OBJ, or `built-in scene NAME`).
+        file: String,
+        /// The field, as a path into the scene file (`objects[2].spheres[0].radius`); empty
+        /// when the problem is with the whole file.
+        field: String,
+        /// What is wrong, or what was expected.
+        msg: String,
+    },
+    /// `host check`: two renders that must be byte-identical differ.
+    Mismatch(String),
+    /// An output could not be encoded or written.
+    Output {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        msg: String,
+    },
     /// Two hit files to compare hold different numbers of records.
     HitCountMismatch {
         /// The reference file and its record count.
@@ -98,7 +117,10 @@ impl fmt::Display for Error {
                 Some(line) => write!(f, "{}:{line}: {msg}", path.display()),
                 None => write!(f, "{}: {msg}", path.display()),
             },
-            Self::Usage(msg) => f.write_str(msg),
+            Self::Usage(msg) | Self::Mismatch(msg) => f.write_str(msg),
+            Self::Scene { file, field, msg } if field.is_empty() => write!(f, "{file}: {msg}"),
+            Self::Scene { file, field, msg } => write!(f, "{file}: {field}: {msg}"),
+            Self::Output { path, msg } => write!(f, "{}: {msg}", path.display()),
             Self::HitCountMismatch { reference, other } => write!(
                 f,
                 "hit files differ in length: {} has {} records, {} has {}",
@@ -121,6 +143,9 @@ impl std::error::Error for Error {
             Self::RunsDiffer { .. }
             | Self::Camera { .. }
             | Self::Usage(_)
+            | Self::Scene { .. }
+            | Self::Mismatch(_)
+            | Self::Output { .. }
             | Self::HitCountMismatch { .. } => None,
         }
     }

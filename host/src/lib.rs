@@ -7,11 +7,17 @@
 //! - [`compare`]: agreement between two hit files,
 //! - [`classify`]: whether rays on which two hit files differ pass within quantization error of
 //!   an edge,
-//! - [`scene`], [`render`]: the built-in scene, cameras, and a primary-ray renderer (PNG out),
+//! - [`spec`]: a scene the host owns, and kernel errors mapped back to its fields,
+//! - [`scenefile`]: the JSON scene format (load, dump),
+//! - [`scene`]: what a SCENE argument names (built-in, scene file, OBJ with camera and lights),
+//! - [`render`]: parallel tiles over the kernel's distribution ray tracer, PNG and PFM out,
+//! - [`check`]: every way of rendering gives the same bytes,
+//! - [`snapshot`]: exact comparison with golden images and hashes,
 //! - [`cli`]: the command line (clap) and the commands behind it,
 //! - [`error`]: the error type `main` turns into a message and an exit code.
 #![forbid(unsafe_code)]
 
+pub mod check;
 pub mod classify;
 pub mod cli;
 pub mod compare;
@@ -21,6 +27,9 @@ pub mod obj;
 pub mod rayfile;
 pub mod render;
 pub mod scene;
+pub mod scenefile;
+pub mod snapshot;
+pub mod spec;
 pub mod trace;
 
 pub use error::Error;

@@ -130,7 +130,8 @@ pub enum ObjErrorKind {
 }
 
 impl ObjError {
-    fn at(path: &Path, line: usize, kind: ObjErrorKind) -> Self {
+    /// An error at `line` of `path`.
+    pub(crate) fn at(path: &Path, line: usize, kind: ObjErrorKind) -> Self {
         Self {
             path: path.to_path_buf(),
             line: Some(line),

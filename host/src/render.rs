@@ -1,74 +1,102 @@
-//! `host render`: a primary-ray renderer on the kernel. One ray through each pixel centre,
-//! Lambert shading (two-sided geometric normal) under one directional light with a hard shadow
-//! ray (`occluded`), a small ambient term, and a background gradient; 8-bit sRGB PNG out.
+//! The host's render path: the kernel's distribution ray tracer ([`raykernel::render`]) over
+//! tiles in parallel (rayon, a local thread pool), and the image files (PNG, PFM).
 //!
-//! Hits come from the kernel in the chosen number mode; the colour arithmetic is `f32` on the
-//! host. Pixels are independent, so the image is the same bytes for any thread count.
+//! Every pixel is a pure function of the scene, the settings and its position, so tiles can run
+//! in any order on any thread: the image is the same bytes for any thread count and tile size
+//! as the kernel's single-threaded [`Renderer::render_srgb8`] (`host check` proves it).
 
 use crate::error::Error;
-use crate::rayfile::FileError;
-use crate::scene::{bounds, cross, normalize, Scene};
-use crate::trace::Mode;
-use raykernel::bvh::{nodes_needed, BuildOptions};
-use raykernel::{Accel, Bvh, Node, Ray, Scalar, Triangle, I16F16};
+use crate::trace::{AccelKind, Mode};
+use indicatif::{ProgressBar, ProgressStyle};
+use raykernel::bvh::BuildOptions;
+use raykernel::geom::spawn::SpawnScalar;
+use raykernel::render::scenes::SceneData;
+use raykernel::render::{
+    encode_srgb8, memory_needed, AccelChoice, Object, RenderPlan, RenderStats, Renderer, Rgb,
+    SceneError, Settings, Shape, Tile,
+};
+use raykernel::{Node, Scalar, Sphere, Triangle, I16F16};
+use rayon::prelude::*;
+use std::io::Write;
 use std::path::Path;
-use std::sync::Mutex;
 use std::time::Instant;
 
-/// What to render and how.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RenderConfig {
-    /// Image width in pixels (at least 1).
-    pub width: u32,
-    /// Image height in pixels (at least 1).
-    pub height: u32,
-    /// Number mode of the kernel.
-    pub mode: Mode,
-    /// Worker threads (at least 1; more than the rows are not started).
-    pub threads: usize,
-    /// BVH builder and leaf size.
-    pub build: BuildOptions,
-}
-
-/// Figures of a render.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct RenderStats {
-    /// Triangles in the scene.
-    pub triangles: usize,
-    /// Wall time of the BVH build (primitives put in leaf order).
-    pub build_ms: f64,
-    /// Wall time of shading every pixel (all threads).
-    pub render_ms: f64,
-    /// Primary rays (one per pixel).
-    pub primary_rays: u64,
-    /// Shadow rays (one per lit-facing hit).
-    pub shadow_rays: u64,
-    /// Primary rays that hit.
-    pub hits: u64,
-    /// Threads used.
-    pub threads: usize,
-}
-
-impl RenderStats {
-    /// Primary and shadow rays.
-    #[must_use]
-    pub fn rays(&self) -> u64 {
-        self.primary_rays + self.shadow_rays
+/// The kernel's accelerator for an [`AccelKind`] chosen on the command line. New kinds (a grid,
+/// a kd-tree) get their arm here once the kernel's [`AccelChoice`] has them.
+#[must_use]
+pub fn accel_choice(kind: AccelKind, build: BuildOptions) -> AccelChoice {
+    match kind {
+        AccelKind::Bvh => AccelChoice::Bvh(build),
+        AccelKind::Linear => AccelChoice::Linear,
     }
+}
 
-    /// Million rays per second of render time.
-    #[must_use]
-    pub fn mrays_per_s(&self) -> f64 {
-        if self.render_ms > 0.0 {
-            self.rays() as f64 / (self.render_ms / 1e3) / 1e6
-        } else {
-            0.0
+/// A short name of an accelerator choice: `linear`, or `bvh sah leaf 4`.
+#[must_use]
+pub fn accel_name(a: AccelChoice) -> String {
+    match a {
+        AccelChoice::Linear => "linear".into(),
+        AccelChoice::Bvh(o) => format!("bvh {} leaf {}", o.builder.name(), o.max_leaf_size),
+    }
+}
+
+/// How to render (the scene and its settings come separately).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderOptions {
+    /// Number mode of the geometry.
+    pub mode: Mode,
+    /// Accelerator of every object.
+    pub accel: AccelChoice,
+    /// Worker threads (at least 1).
+    pub threads: usize,
+    /// Tile width and height in pixels (at least 1 each).
+    pub tile: (u32, u32),
+    /// Show a progress bar on stderr (only drawn when stderr is a terminal).
+    pub progress: bool,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self {
+            mode: Mode::F32,
+            accel: AccelChoice::default(),
+            threads: 1,
+            tile: (16, 16),
+            progress: false,
         }
     }
 }
 
-/// A rendered image: `width * height` RGB pixels, 8-bit sRGB, rows top to bottom.
+/// A rendered image in linear RGB (mean radiance per pixel), rows top to bottom.
 #[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width * height` pixels.
+    pub linear: Vec<Rgb>,
+}
+
+impl Frame {
+    /// The 8-bit sRGB image (the kernel's [`encode_srgb8`] per channel: the same bytes as the
+    /// kernel's `render_srgb8`).
+    #[must_use]
+    pub fn srgb8(&self) -> Image {
+        Image {
+            width: self.width,
+            height: self.height,
+            rgb: self
+                .linear
+                .iter()
+                .flat_map(|p| p.map(encode_srgb8))
+                .collect(),
+        }
+    }
+}
+
+/// An 8-bit sRGB image: `width * height` RGB pixels, rows top to bottom.
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Image {
     /// Width in pixels.
     pub width: u32,
@@ -78,271 +106,322 @@ pub struct Image {
     pub rgb: Vec<u8>,
 }
 
-/// Renders `scene`.
+/// A finished render.
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    /// The picture.
+    pub frame: Frame,
+    /// What the kernel did.
+    pub plan: RenderPlan,
+    /// Rays cast.
+    pub stats: RenderStats,
+    /// Wall time of converting the scene and building the accelerators.
+    pub build_ms: f64,
+    /// Wall time of rendering every tile.
+    pub render_ms: f64,
+}
+
+/// Builds the kernel's renderer for `data` in mode `S` (converted primitives, objects and BVH
+/// memory owned here) and hands it to `f`; returns `f`'s result and the build time in ms.
 ///
 /// # Errors
-/// [`Error::Obj`] for a vertex the mode cannot represent, [`Error::Build`] if the kernel
-/// refuses to build, [`Error::Usage`] if the camera cannot be used (e.g. its eye lies outside
-/// the fixed-point range).
-///
-/// # Panics
-/// If `config.threads`, `config.width` or `config.height` is 0.
-pub fn render(scene: &Scene, config: &RenderConfig) -> Result<(Image, RenderStats), Error> {
-    match config.mode {
-        Mode::F32 => render_in::<f32>(scene, config),
-        Mode::Fixed => render_in::<I16F16>(scene, config),
-    }
-}
-
-fn render_in<S: Scalar>(
-    scene: &Scene,
-    config: &RenderConfig,
-) -> Result<(Image, RenderStats), Error> {
-    assert!(config.threads > 0 && config.width > 0 && config.height > 0);
-    let label = Path::new(&scene.name);
-    let mut tris: Vec<Triangle<S>> = match &scene.obj {
-        Some((path, mesh)) => mesh.kernel_triangles::<S>(path)?,
-        None => scene
-            .triangles
-            .iter()
-            .map(|&v| Triangle::from_f32(v))
-            .collect::<Result<_, _>>()
-            .map_err(|(corner, e)| {
-                Error::Usage(format!("{label:?}: vertex {corner} unusable: {e}"))
-            })?,
-    };
-    let shader = Shader::new(scene, config)?;
-    // The eye must be a usable ray origin in this mode.
-    let (eye, dir) = shader.view.ray(config.width / 2, config.height / 2);
-    Ray::<S>::from_f32(eye, dir, 0.0, f32::INFINITY).map_err(|e| {
-        Error::Usage(format!(
-            "{}: camera eye {eye:?} unusable in {} mode: {e}",
-            scene.name,
-            S::NAME
-        ))
-    })?;
-
-    let mut nodes = vec![Node::<S>::EMPTY; nodes_needed(tris.len())];
-    let mut ids = vec![0u32; tris.len()];
+/// The kernel's [`SceneError`] (map it with [`crate::spec::SceneSpec::explain`]).
+pub fn with_renderer<S: SpawnScalar, R>(
+    data: &SceneData<'_>,
+    settings: Settings,
+    accel: AccelChoice,
+    f: impl for<'r> FnOnce(&Renderer<'r, S>) -> R,
+) -> Result<(R, f64), SceneError> {
     let start = Instant::now();
-    let bvh = Bvh::build_in_leaf_order(&mut tris, &mut nodes, &mut ids, config.build).map_err(
-        |source| Error::Build {
-            scene: label.to_path_buf(),
-            source,
-        },
-    )?;
+    let mut triangles = vec![
+        Triangle {
+            v: [[S::ZERO; 3]; 3]
+        };
+        data.triangles.len()
+    ];
+    data.triangles_into(&mut triangles)?;
+    let mut spheres = vec![
+        Sphere {
+            center: [S::ZERO; 3],
+            radius: S::ZERO,
+        };
+        data.spheres.len()
+    ];
+    data.spheres_into(&mut spheres)?;
+    let mut objects = vec![Object::new(Shape::Triangles(&[]), 0); data.objects.len()];
+    let scene = data.scene(&triangles, &spheres, &mut objects)?;
+    let (node_count, id_count) = match accel {
+        AccelChoice::Bvh(_) => memory_needed(scene.objects),
+        AccelChoice::Linear => (0, 0),
+    };
+    let mut nodes = vec![Node::<S>::EMPTY; node_count];
+    let mut ids = vec![0u32; id_count];
+    let renderer = Renderer::new(&scene, settings, accel, &mut nodes, &mut ids)?;
     let build_ms = start.elapsed().as_secs_f64() * 1e3;
-
-    let (w, h) = (config.width as usize, config.height as usize);
-    let mut rgb = vec![0u8; 3 * w * h];
-    let threads = config.threads.min(h);
-    let start = Instant::now();
-    let counts = {
-        // Rows are handed out one at a time, so uneven rows balance across threads.
-        let rows = Mutex::new(rgb.chunks_mut(3 * w).enumerate());
-        let work = || {
-            let mut counts = Counts::default();
-            loop {
-                let next = rows.lock().unwrap_or_else(|e| e.into_inner()).next();
-                let Some((y, row)) = next else { break };
-                for (x, px) in row.chunks_exact_mut(3).enumerate() {
-                    let c = shader.pixel(&bvh, x as u32, y as u32, &mut counts);
-                    px.copy_from_slice(&c.map(to_srgb8));
-                }
-            }
-            counts
-        };
-        std::thread::scope(|s| {
-            let handles: Vec<_> = (0..threads).map(|_| s.spawn(work)).collect();
-            handles
-                .into_iter()
-                .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-                .fold(Counts::default(), Counts::add)
-        })
-    };
-    let render_ms = start.elapsed().as_secs_f64() * 1e3;
-    let stats = RenderStats {
-        triangles: tris.len(),
-        build_ms,
-        render_ms,
-        primary_rays: counts.primary,
-        shadow_rays: counts.shadow,
-        hits: counts.hits,
-        threads,
-    };
-    let image = Image {
-        width: config.width,
-        height: config.height,
-        rgb,
-    };
-    Ok((image, stats))
+    Ok((f(&renderer), build_ms))
 }
 
-#[derive(Clone, Copy, Default)]
-struct Counts {
-    primary: u64,
-    shadow: u64,
-    hits: u64,
-}
-
-impl Counts {
-    fn add(self, o: Self) -> Self {
-        Self {
-            primary: self.primary + o.primary,
-            shadow: self.shadow + o.shadow,
-            hits: self.hits + o.hits,
-        }
+/// The plan the kernel derives for `data` with `settings` in `mode` (nothing is rendered).
+///
+/// # Errors
+/// As [`with_renderer`].
+pub fn plan(
+    data: &SceneData<'_>,
+    settings: Settings,
+    mode: Mode,
+) -> Result<RenderPlan, SceneError> {
+    fn go<S: SpawnScalar>(d: &SceneData<'_>, s: Settings) -> Result<RenderPlan, SceneError> {
+        with_renderer::<S, _>(d, s, AccelChoice::Linear, |r| *r.plan()).map(|(p, _)| p)
+    }
+    match mode {
+        Mode::F32 => go::<f32>(data, settings),
+        Mode::Fixed => go::<I16F16>(data, settings),
     }
 }
 
-/// Ambient light (fraction of the albedo every visible surface gets).
-const AMBIENT: f32 = 0.12;
-/// Extra ambient on surfaces facing up (a hint of sky light).
-const SKY: f32 = 0.1;
-/// Strength of the directional light.
-const SUN: f32 = 0.9;
-
-/// Everything per-pixel shading needs except the accelerator.
-struct Shader<'s> {
-    scene: &'s Scene,
-    view: crate::scene::View,
-    /// Unit vector towards the light.
-    light: [f32; 3],
-    /// The camera's up: background gradient and sky term.
-    up: [f32; 3],
-    /// How far shadow rays start off the surface.
-    offset: f32,
+/// Renders `data` with `settings`: parallel tiles on a local pool of `options.threads`.
+///
+/// # Errors
+/// The kernel's [`SceneError`] for the scene or settings, or [`Error::Usage`] if the thread
+/// pool cannot be started (wrapped so the caller maps scene errors itself).
+pub fn render(
+    data: &SceneData<'_>,
+    settings: Settings,
+    options: &RenderOptions,
+) -> Result<Rendered, RenderError> {
+    match options.mode {
+        Mode::F32 => render_in::<f32>(data, settings, options),
+        Mode::Fixed => render_in::<I16F16>(data, settings, options),
+    }
 }
 
-impl<'s> Shader<'s> {
-    fn new(scene: &'s Scene, config: &RenderConfig) -> Result<Self, Error> {
-        let view = scene
-            .camera
-            .view(config.width, config.height)
-            .ok_or_else(|| Error::Usage(format!("{}: unusable camera", scene.name)))?;
-        let light = scene.light.unwrap_or_else(|| {
-            // Above and behind the camera, a little to its left.
-            let (u, f, r) = (view.up(), view.forward(), view.right());
-            normalize(std::array::from_fn(|k| {
-                1.6 * u[k] - 0.7 * f[k] - 0.5 * r[k]
-            }))
+/// Why [`render`] failed.
+#[derive(Debug)]
+pub enum RenderError {
+    /// The kernel rejected the scene or settings.
+    Scene(SceneError),
+    /// The thread pool could not be started.
+    Pool(String),
+}
+
+impl From<SceneError> for RenderError {
+    fn from(e: SceneError) -> Self {
+        Self::Scene(e)
+    }
+}
+
+fn render_in<S: SpawnScalar + Send + Sync>(
+    data: &SceneData<'_>,
+    settings: Settings,
+    options: &RenderOptions,
+) -> Result<Rendered, RenderError> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(options.threads.max(1))
+        .build()
+        .map_err(|e| RenderError::Pool(e.to_string()))?;
+    let (result, build_ms) = with_renderer::<S, _>(data, settings, options.accel, |r| {
+        let start = Instant::now();
+        let tiles = tiles(settings.width, settings.height, options.tile);
+        let bar = progress_bar(options.progress, &settings, tiles.len());
+        let rendered: Vec<Result<(Vec<Rgb>, RenderStats), SceneError>> = pool.install(|| {
+            tiles
+                .par_iter()
+                .map(|t| {
+                    let mut buf = vec![[0.0; 3]; t.width as usize * t.height as usize];
+                    let stats = r.render_tile(*t, &mut buf)?;
+                    bar.inc(1);
+                    Ok((buf, stats))
+                })
+                .collect()
         });
-        // Off the surface by a small fraction of the scene, and by several fixed-point units.
-        let (lo, hi) = bounds(&scene.triangles);
-        let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
-        let offset = (extent * 2e-4).max(16.0 / 65536.0) as f32;
-        Ok(Self {
-            scene,
-            view,
-            light: light.map(|x| x as f32),
-            up: view.up().map(|x| x as f32),
-            offset,
-        })
-    }
-
-    /// Linear RGB of pixel (`x`, `y`).
-    fn pixel<S: Scalar, A: Accel<S>>(&self, accel: &A, x: u32, y: u32, n: &mut Counts) -> [f32; 3] {
-        let (o, d) = self.view.ray(x, y);
-        n.primary += 1;
-        let hit = Ray::<S>::from_f32(o, d, 0.0, f32::INFINITY)
-            .ok()
-            .and_then(|ray| accel.intersect(&ray));
-        let Some(hit) = hit else {
-            return self.background(d);
-        };
-        n.hits += 1;
-        let id = hit.prim as usize;
-        let [a, b, c] = self.scene.triangles[id];
-        let (u, v) = (hit.u.to_f32(), hit.v.to_f32());
-        let w = 1.0 - u - v;
-        let p: [f32; 3] = std::array::from_fn(|k| w * a[k] + u * b[k] + v * c[k]);
-        // Geometric normal, turned towards the viewer (triangles are two-sided).
-        let e1: [f32; 3] = std::array::from_fn(|k| b[k] - a[k]);
-        let e2: [f32; 3] = std::array::from_fn(|k| c[k] - a[k]);
-        let mut normal = unit(cross3(e1, e2)).unwrap_or(d.map(|x| -x));
-        if dot(normal, d) > 0.0 {
-            normal = normal.map(|x| -x);
-        }
-        let facing = dot(normal, self.light);
-        let mut sun = 0.0;
-        if facing > 0.0 {
-            n.shadow += 1;
-            let origin: [f32; 3] = std::array::from_fn(|k| p[k] + self.offset * normal[k]);
-            let blocked = Ray::<S>::from_f32(origin, self.light, 0.0, f32::INFINITY)
-                .is_ok_and(|ray| accel.occluded(&ray));
-            if !blocked {
-                sun = facing;
+        bar.finish_and_clear();
+        let (w, h) = (settings.width as usize, settings.height as usize);
+        let mut linear = vec![[0.0; 3]; w * h];
+        let mut stats = RenderStats::default();
+        for (t, result) in tiles.iter().zip(rendered) {
+            let (buf, s) = result?;
+            stats = stats.add(s);
+            for (row, src) in buf.chunks_exact(t.width as usize).enumerate() {
+                let at = (t.y as usize + row) * w + t.x as usize;
+                linear[at..at + src.len()].copy_from_slice(src);
             }
         }
-        let sky = 0.5 + 0.5 * dot(normal, self.up);
-        let light = AMBIENT + SKY * sky + SUN * sun;
-        self.scene.albedo[id].map(|a| a * light)
-    }
-
-    /// Sky gradient by the direction's height: pale at the horizon and below, blue above.
-    fn background(&self, d: [f32; 3]) -> [f32; 3] {
-        let s = dot(d, self.up).clamp(0.0, 1.0);
-        let (horizon, zenith) = ([0.80, 0.84, 0.90], [0.22, 0.38, 0.70]);
-        std::array::from_fn(|k| horizon[k] + (zenith[k] - horizon[k]) * s)
-    }
+        Ok::<_, SceneError>(Rendered {
+            frame: Frame {
+                width: settings.width,
+                height: settings.height,
+                linear,
+            },
+            plan: *r.plan(),
+            stats,
+            build_ms: 0.0,
+            render_ms: start.elapsed().as_secs_f64() * 1e3,
+        })
+    })?;
+    let mut rendered = result?;
+    rendered.build_ms = build_ms;
+    Ok(rendered)
 }
 
-fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross3(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    let c = cross(a.map(f64::from), b.map(f64::from));
-    c.map(|x| x as f32)
-}
-
-fn unit(a: [f32; 3]) -> Option<[f32; 3]> {
-    let l = dot(a, a).sqrt();
-    (l > 0.0 && l.is_finite()).then(|| a.map(|x| x / l))
-}
-
-/// Linear `[0, 1]` to an 8-bit sRGB value (clamped; NaN is 0).
+/// The tiles covering a `width`×`height` image, row by row; edge tiles are cut to fit.
 #[must_use]
-pub fn to_srgb8(c: f32) -> u8 {
-    let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
-    let s = if c <= 0.003_130_8 {
-        12.92 * c
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    };
-    // In [0, 255.5): the cast neither saturates nor wraps.
-    (s * 255.0 + 0.5) as u8
+pub fn tiles(width: u32, height: u32, (tw, th): (u32, u32)) -> Vec<Tile> {
+    let (tw, th) = (tw.max(1), th.max(1));
+    let mut out = Vec::new();
+    for y in (0..height).step_by(th as usize) {
+        for x in (0..width).step_by(tw as usize) {
+            out.push(Tile {
+                x,
+                y,
+                width: tw.min(width - x),
+                height: th.min(height - y),
+            });
+        }
+    }
+    out
+}
+
+/// Samples above which a render counts as long enough for a progress bar.
+const LONG_RENDER_SAMPLES: u64 = 4 << 20;
+
+fn progress_bar(wanted: bool, s: &Settings, tiles: usize) -> ProgressBar {
+    use std::io::IsTerminal;
+    let samples = u64::from(s.width) * u64::from(s.height) * u64::from(s.spp);
+    if !wanted || samples < LONG_RENDER_SAMPLES || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let style = ProgressStyle::with_template(
+        "{spinner} rendering [{bar:30}] {pos}/{len} tiles, {elapsed} (eta {eta})",
+    )
+    .map_or_else(
+        |_| ProgressStyle::default_bar(),
+        |s| s.progress_chars("=> "),
+    );
+    ProgressBar::new(tiles as u64).with_style(style)
+}
+
+/// The kernel's single-threaded whole-image path ([`Renderer::render_srgb8`]): the reference
+/// for `host check`.
+///
+/// # Errors
+/// The kernel's [`SceneError`].
+pub fn render_reference(
+    data: &SceneData<'_>,
+    settings: Settings,
+    mode: Mode,
+    accel: AccelChoice,
+) -> Result<Image, SceneError> {
+    fn go<S: SpawnScalar>(
+        d: &SceneData<'_>,
+        s: Settings,
+        a: AccelChoice,
+    ) -> Result<Image, SceneError> {
+        let mut rgb = vec![0u8; 3 * s.width as usize * s.height as usize];
+        with_renderer::<S, _>(d, s, a, |r| r.render_srgb8(&mut rgb))?.0?;
+        Ok(Image {
+            width: s.width,
+            height: s.height,
+            rgb,
+        })
+    }
+    match mode {
+        Mode::F32 => go::<f32>(data, settings, accel),
+        Mode::Fixed => go::<I16F16>(data, settings, accel),
+    }
+}
+
+/// The mode's name as in reports and file names: `f32` or `fixed`.
+#[must_use]
+pub fn mode_name(mode: Mode) -> &'static str {
+    match mode {
+        Mode::F32 => <f32 as Scalar>::NAME,
+        Mode::Fixed => <I16F16 as Scalar>::NAME,
+    }
 }
 
 /// The PNG bytes of `image` (8-bit RGB, marked sRGB).
 ///
 /// # Errors
-/// [`Error::Usage`] if the encoder refuses (it does not for a well-formed image).
-pub fn encode_png(image: &Image) -> Result<Vec<u8>, Error> {
+/// A message if the encoder refuses (it does not for a well-formed image).
+pub fn encode_png(image: &Image) -> Result<Vec<u8>, String> {
     let mut out = Vec::new();
     let mut enc = png::Encoder::new(&mut out, image.width, image.height);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
     enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-    let fail = |e: png::EncodingError| Error::Usage(format!("cannot encode PNG: {e}"));
+    let fail = |e: png::EncodingError| format!("cannot encode PNG: {e}");
     let mut writer = enc.write_header().map_err(fail)?;
     writer.write_image_data(&image.rgb).map_err(fail)?;
     writer.finish().map_err(fail)?;
     Ok(out)
 }
 
+/// Decodes an 8-bit RGB PNG.
+///
+/// # Errors
+/// A message for bytes that are not such a PNG.
+pub fn decode_png(bytes: &[u8]) -> Result<Image, String> {
+    let mut reader = png::Decoder::new(std::io::Cursor::new(bytes))
+        .read_info()
+        .map_err(|e| format!("not a PNG: {e}"))?;
+    let size = reader
+        .output_buffer_size()
+        .ok_or_else(|| "PNG too large".to_string())?;
+    let mut buf = vec![0; size];
+    let info = reader
+        .next_frame(&mut buf)
+        .map_err(|e| format!("bad PNG data: {e}"))?;
+    if info.color_type != png::ColorType::Rgb || info.bit_depth != png::BitDepth::Eight {
+        return Err(format!(
+            "expected 8-bit RGB, found {:?} {:?}",
+            info.color_type, info.bit_depth
+        ));
+    }
+    buf.truncate(info.buffer_size());
+    Ok(Image {
+        width: info.width,
+        height: info.height,
+        rgb: buf,
+    })
+}
+
 /// Writes `image` as a PNG file.
 ///
 /// # Errors
-/// As [`encode_png`], or [`FileError::Write`].
+/// [`Error::Output`] if it cannot be encoded or written.
 pub fn write_png(path: &Path, image: &Image) -> Result<(), Error> {
-    let bytes = encode_png(image)?;
-    std::fs::write(path, bytes).map_err(|source| {
-        Error::File(FileError::Write {
+    let fail = |msg: String| Error::Output {
+        path: path.to_path_buf(),
+        msg,
+    };
+    let bytes = encode_png(image).map_err(fail)?;
+    std::fs::write(path, bytes).map_err(|e| fail(format!("cannot write: {e}")))
+}
+
+/// The PFM bytes of `frame`: `PF`, size, `-1.0` (little-endian), then 32-bit floats, rows
+/// bottom to top, linear RGB as rendered (no clipping, no encoding).
+#[must_use]
+pub fn encode_pfm(frame: &Frame) -> Vec<u8> {
+    let mut out = format!("PF\n{} {}\n-1.0\n", frame.width, frame.height).into_bytes();
+    for row in frame.linear.chunks(frame.width.max(1) as usize).rev() {
+        for x in row.iter().flatten() {
+            out.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    out
+}
+
+/// Writes `frame` as a PFM file.
+///
+/// # Errors
+/// [`Error::Output`] if it cannot be written.
+pub fn write_pfm(path: &Path, frame: &Frame) -> Result<(), Error> {
+    std::fs::File::create(path)
+        .and_then(|mut f| f.write_all(&encode_pfm(frame)))
+        .map_err(|e| Error::Output {
             path: path.to_path_buf(),
-            source,
+            msg: format!("cannot write: {e}"),
         })
-    })
 }
 
 #[cfg(test)]
@@ -350,21 +429,31 @@ mod tests {
     use super::*;
 
     #[test]
-    fn srgb_endpoints_and_midtones() {
-        assert_eq!(to_srgb8(0.0), 0);
-        assert_eq!(to_srgb8(1.0), 255);
-        assert_eq!(to_srgb8(2.0), 255);
-        assert_eq!(to_srgb8(-1.0), 0);
-        assert_eq!(to_srgb8(f32::NAN), 0);
-        // Linear 0.5 is sRGB 0.7354 -> 187.5 + 0.5 -> 188; 0.2 is sRGB 0.4845 -> 124.
-        assert_eq!(to_srgb8(0.5), 188);
-        assert_eq!(to_srgb8(0.2), 124);
-        assert_eq!(to_srgb8(0.003), 10); // linear segment: 12.92 * 0.003 * 255 = 9.88
-        let mut last = 0;
-        for i in 0..=1000 {
-            let v = to_srgb8(i as f32 / 1000.0);
-            assert!(v >= last);
-            last = v;
+    fn tiles_cover_the_image_once() {
+        for (w, h, t) in [(64, 48, (16, 16)), (10, 7, (3, 5)), (1, 1, (16, 16))] {
+            let mut seen = vec![0u8; (w * h) as usize];
+            for tile in tiles(w, h, t) {
+                for y in tile.y..tile.y + tile.height {
+                    for x in tile.x..tile.x + tile.width {
+                        seen[(y * w + x) as usize] += 1;
+                    }
+                }
+            }
+            assert!(seen.iter().all(|&n| n == 1), "{w}x{h} tiles {t:?}");
         }
+    }
+
+    #[test]
+    fn pfm_header_and_row_order() {
+        let f = Frame {
+            width: 1,
+            height: 2,
+            linear: vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]],
+        };
+        let b = encode_pfm(&f);
+        let head = b"PF\n1 2\n-1.0\n";
+        assert_eq!(&b[..head.len()], head);
+        // Bottom row first.
+        assert_eq!(&b[head.len()..head.len() + 4], &4.0f32.to_le_bytes());
     }
 }

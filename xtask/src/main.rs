@@ -7,6 +7,9 @@
 //!   on failure, lists the kernel source lines that still reach a panic.
 //! - `cargo xtask size`: the footprint table of the README (code size of a build + traverse
 //!   probe, arena bytes per triangle, stack high-water marks measured on target).
+//! - `cargo xtask bless`: rewrites the goldens: the hash file `tests/golden/kernel_hashes.txt`
+//!   (the kernel's golden test), then the snapshot PNGs `tests/golden/images/` (the host's
+//!   snapshot test, which also checks its renders against the new hashes).
 //!
 //! Cargo reads `.cargo/config.toml` from the current directory, so every on-target command runs
 //! inside `tests/qemu`.
@@ -47,8 +50,9 @@ fn main() -> ExitCode {
             r.1 == 0
         }
         Some("size") => size(),
+        Some("bless") => bless(),
         _ => {
-            eprintln!("usage: cargo xtask <qemu | panic-check | size>");
+            eprintln!("usage: cargo xtask <qemu | panic-check | size | bless>");
             false
         }
     };
@@ -57,6 +61,26 @@ fn main() -> ExitCode {
     } else {
         ExitCode::FAILURE
     }
+}
+
+/// `BLESS=1 cargo test` of the kernel's golden hashes, then of the host's snapshots, from the
+/// repository root.
+fn bless() -> bool {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    for (package, test) in [("raykernel", "golden"), ("raykernel-host", "snapshots")] {
+        let status = Command::new(&cargo)
+            .current_dir(&root)
+            .args(["test", "-p", package, "--test", test])
+            .env("BLESS", "1")
+            .status();
+        if !status.is_ok_and(|s| s.success()) {
+            eprintln!("bless: `BLESS=1 cargo test -p {package} --test {test}` failed");
+            return false;
+        }
+    }
+    println!("blessed tests/golden/kernel_hashes.txt and tests/golden/images/");
+    true
 }
 
 fn qemu_dir() -> PathBuf {

@@ -1,0 +1,886 @@
+//! Scene files: a versioned JSON format for scenes written by hand or by other tools (documented
+//! in `docs/SCENE_FORMAT.md`), loaded into a [`SceneSpec`], and the dump of any kernel
+//! [`SceneData`] (every built-in scene) into the same format.
+//!
+//! Every struct denies unknown fields, so a misspelt key is an error, not a silent default.
+//! Errors name the file, the field as a path (`objects[2].spheres[0].radius`, from
+//! `serde_path_to_error`) and what was expected; values the kernel rejects are reported the
+//! same way ([`SceneSpec::explain`]).
+
+use crate::error::Error;
+use crate::obj::load_obj;
+use crate::spec::{ObjectSource, SceneOrigin, SceneSpec};
+use raykernel::render::scenes::{ObjectData, SceneData, ShapeRange, SphereData};
+use raykernel::render::{AccelChoice, Camera, Filter, Light, Material, SamplerKind, Settings};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+/// The `format` key every scene file starts with.
+pub const FORMAT: &str = "raykernel-scene";
+/// The version this reader reads and the dump writes.
+pub const VERSION: u32 = 1;
+
+/// Settings for fields a scene file leaves out (and for OBJ scenes).
+pub const DEFAULT_SETTINGS: Settings = Settings {
+    width: 512,
+    height: 512,
+    spp: 64,
+    max_depth: 4,
+    sampler: SamplerKind::Stratified,
+    filter: Filter::Box,
+    seed: 0,
+};
+
+/// A whole scene file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Always `raykernel-scene`.
+    pub format: String,
+    /// Always 1 (this reader's [`VERSION`]).
+    pub version: u32,
+    /// Short name (defaults to the file's stem).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// The camera.
+    pub camera: CameraEntry,
+    /// Radiance of rays that leave the scene (default black).
+    #[serde(default)]
+    pub background: [f32; 3],
+    /// Render settings (each optional).
+    #[serde(default)]
+    pub settings: SettingsEntry,
+    /// Named materials.
+    pub materials: Vec<MaterialEntry>,
+    /// Objects.
+    pub objects: Vec<ObjectEntry>,
+    /// Lights (default none).
+    #[serde(default)]
+    pub lights: Vec<LightEntry>,
+}
+
+/// `camera`: a thin lens (pinhole when `aperture_radius` is 0).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraEntry {
+    /// Lens centre.
+    pub eye: [f32; 3],
+    /// A point on the optical axis.
+    pub look_at: [f32; 3],
+    /// Up hint (default +y).
+    #[serde(default = "up_y")]
+    pub up: [f32; 3],
+    /// Full vertical field of view, degrees.
+    pub vfov_deg: f32,
+    /// Lens radius, world units (default 0: pinhole).
+    #[serde(default)]
+    pub aperture_radius: f32,
+    /// Distance to the plane in focus (default: from `eye` to `look_at`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub focus_distance: Option<f32>,
+}
+
+fn up_y() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+/// `settings`: every field optional ([`DEFAULT_SETTINGS`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SettingsEntry {
+    /// Image width, pixels.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub width: Option<u32>,
+    /// Image height, pixels.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height: Option<u32>,
+    /// Samples per pixel.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spp: Option<u32>,
+    /// Most reflection bounces.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_depth: Option<u32>,
+    /// Sample placement.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sampler: Option<SamplerName>,
+    /// Pixel filter.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filter: Option<FilterName>,
+    /// Seed of every random value.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u32>,
+}
+
+/// `settings.sampler`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum SamplerName {
+    /// Independent uniform values.
+    Independent,
+    /// Jittered grid.
+    Stratified,
+    /// Owen-scrambled Sobol.
+    Sobol,
+}
+
+impl From<SamplerName> for SamplerKind {
+    fn from(s: SamplerName) -> Self {
+        match s {
+            SamplerName::Independent => Self::Independent,
+            SamplerName::Stratified => Self::Stratified,
+            SamplerName::Sobol => Self::Sobol,
+        }
+    }
+}
+
+impl From<SamplerKind> for SamplerName {
+    fn from(s: SamplerKind) -> Self {
+        match s {
+            SamplerKind::Independent => Self::Independent,
+            SamplerKind::Stratified => Self::Stratified,
+            SamplerKind::Sobol => Self::Sobol,
+        }
+    }
+}
+
+/// `settings.filter`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum FilterName {
+    /// Uniform over the pixel.
+    Box,
+    /// Triangle of radius one pixel.
+    Tent,
+}
+
+impl From<FilterName> for Filter {
+    fn from(f: FilterName) -> Self {
+        match f {
+            FilterName::Box => Self::Box,
+            FilterName::Tent => Self::Tent,
+        }
+    }
+}
+
+impl From<Filter> for FilterName {
+    fn from(f: Filter) -> Self {
+        match f {
+            Filter::Box => Self::Box,
+            Filter::Tent => Self::Tent,
+        }
+    }
+}
+
+/// One entry of `materials`: a name and exactly one kind.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialEntry {
+    /// The name objects refer to it by (unique).
+    pub name: String,
+    /// Lambertian.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diffuse: Option<Diffuse>,
+    /// Perfect mirror.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mirror: Option<Mirror>,
+    /// Phong lobe around the mirror direction.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub glossy: Option<Glossy>,
+    /// Emits radiance, reflects nothing.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emissive: Option<Emissive>,
+}
+
+/// `diffuse`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Diffuse {
+    /// Reflectance per channel, `[0, 1]`.
+    pub albedo: [f32; 3],
+}
+
+/// `mirror`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Mirror {
+    /// Reflectance per channel, `[0, 1]`.
+    pub reflectance: [f32; 3],
+}
+
+/// `glossy`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Glossy {
+    /// Reflectance per channel, `[0, 1]`.
+    pub reflectance: [f32; 3],
+    /// Phong exponent, `>= 1` (larger is sharper).
+    pub exponent: f32,
+}
+
+/// `emissive`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Emissive {
+    /// Emitted radiance per channel (W·sr⁻¹·m⁻²), `>= 0`.
+    pub radiance: [f32; 3],
+}
+
+/// One entry of `objects`: exactly one of `mesh`, `triangles`, `spheres`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectEntry {
+    /// An OBJ file, relative to the scene file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<String>,
+    /// Triangles written out: three `[x, y, z]` corners each.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub triangles: Option<Vec<[[f32; 3]; 3]>>,
+    /// Spheres.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spheres: Option<Vec<SphereEntry>>,
+    /// Placement of a mesh or of triangles (not spheres).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transform: Option<Transform>,
+    /// The material's name.
+    pub material: String,
+    /// Displacement over the shutter interval (default none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<[f32; 3]>,
+}
+
+/// A sphere.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereEntry {
+    /// Centre.
+    pub center: [f32; 3],
+    /// Radius, `>= 0`.
+    pub radius: f32,
+}
+
+/// `transform`: scale, then rotate about x, then y, then z, then translate.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Transform {
+    /// Uniform (a number) or per-axis (`[sx, sy, sz]`) scale.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<Scale>,
+    /// Rotations in degrees about the x, y and z axes (right-handed), applied in that order.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotate_deg: Option<[f64; 3]>,
+    /// Translation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub translate: Option<[f64; 3]>,
+}
+
+/// A scale factor: one number or one per axis.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged, expecting = "a number or an array of 3 numbers")]
+pub enum Scale {
+    /// The same on every axis.
+    Uniform(f64),
+    /// Per axis.
+    PerAxis([f64; 3]),
+}
+
+impl Transform {
+    /// The transformed point, computed in `f64` and rounded to `f32` once.
+    #[must_use]
+    pub fn apply(&self, p: [f32; 3]) -> [f32; 3] {
+        let s = match self.scale {
+            None => [1.0; 3],
+            Some(Scale::Uniform(s)) => [s; 3],
+            Some(Scale::PerAxis(s)) => s,
+        };
+        let mut q: [f64; 3] = std::array::from_fn(|k| f64::from(p[k]) * s[k]);
+        if let Some(r) = self.rotate_deg {
+            for (axis, deg) in r.iter().enumerate() {
+                let (sin, cos) = deg.to_radians().sin_cos();
+                // The two coordinates the rotation about `axis` mixes, in right-handed order.
+                let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+                let (x, y) = (q[a], q[b]);
+                q[a] = cos * x - sin * y;
+                q[b] = sin * x + cos * y;
+            }
+        }
+        let t = self.translate.unwrap_or([0.0; 3]);
+        std::array::from_fn(|k| (q[k] + t[k]) as f32)
+    }
+}
+
+/// One entry of `lights`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
+pub enum LightEntry {
+    /// A point light.
+    Point {
+        /// Position.
+        position: [f32; 3],
+        /// Radiant intensity per channel (W·sr⁻¹).
+        intensity: [f32; 3],
+    },
+    /// A parallelogram emitting towards `edge_u × edge_v`.
+    Rect {
+        /// One corner.
+        corner: [f32; 3],
+        /// First edge.
+        edge_u: [f32; 3],
+        /// Second edge.
+        edge_v: [f32; 3],
+        /// Radiance (W·sr⁻¹·m⁻²).
+        radiance: [f32; 3],
+    },
+    /// A sphere emitting outwards.
+    Sphere {
+        /// Centre.
+        center: [f32; 3],
+        /// Radius, `> 0`.
+        radius: f32,
+        /// Radiance (W·sr⁻¹·m⁻²).
+        radiance: [f32; 3],
+    },
+}
+
+/// Only `format` and `version`: read first, so a file of another version gets that message
+/// rather than one about fields this reader does not know.
+#[derive(Deserialize)]
+struct Header {
+    format: Option<Value>,
+    version: Option<Value>,
+}
+
+/// Reads and checks a scene file: JSON syntax and types, names, references, and every value
+/// the kernel checks (in `f32`; the fixed-point range is checked when rendering in that mode).
+///
+/// # Errors
+/// [`Error::Scene`] naming the file, the field and the problem; [`Error::File`] if the file
+/// cannot be read. Meshes that cannot be read or parsed are reported at their `mesh` field.
+pub fn load_scene_file(path: &Path) -> Result<SceneSpec, Error> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::Scene {
+        file: path.display().to_string(),
+        field: String::new(),
+        msg: format!("cannot read: {e}"),
+    })?;
+    parse_scene_file(&text, path)
+}
+
+/// Parses scene-file text; `path` names the file in errors and anchors relative mesh paths.
+///
+/// # Errors
+/// As [`load_scene_file`].
+pub fn parse_scene_file(text: &str, path: &Path) -> Result<SceneSpec, Error> {
+    let err = |field: &str, msg: String| Error::Scene {
+        file: path.display().to_string(),
+        field: field.to_string(),
+        msg,
+    };
+    let header: Header = serde_json::from_str(text).map_err(|e| err("", e.to_string()))?;
+    match header.format {
+        Some(Value::String(f)) if f == FORMAT => {}
+        Some(other) => {
+            return Err(err(
+                "format",
+                format!("expected \"{FORMAT}\", found {other}"),
+            ))
+        }
+        None => {
+            return Err(err(
+                "format",
+                format!("missing: a scene file starts with \"format\": \"{FORMAT}\""),
+            ))
+        }
+    }
+    match header.version {
+        Some(Value::Number(n)) if n.as_u64() == Some(u64::from(VERSION)) => {}
+        Some(other) => {
+            return Err(err(
+                "version",
+                format!("this reader reads version {VERSION}, found {other}"),
+            ))
+        }
+        None => return Err(err("version", format!("missing: expected {VERSION}"))),
+    }
+    let mut de = serde_json::Deserializer::from_str(text);
+    let file: SceneFile = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        let field = e.path().to_string();
+        let field = if field == "." { String::new() } else { field };
+        err(&field, e.into_inner().to_string())
+    })?;
+    let stem = path
+        .file_stem()
+        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+    let spec = resolve(file, path, &stem)?;
+    check_in_kernel(&spec)?;
+    Ok(spec)
+}
+
+/// Checks `spec` the way the kernel will: builds an `f32` renderer over it with brute force
+/// (no memory needed) and maps any error back to the scene's fields.
+///
+/// # Errors
+/// [`SceneSpec::explain`] of the kernel's error.
+pub fn check_in_kernel(spec: &SceneSpec) -> Result<(), Error> {
+    crate::render::with_renderer::<f32, _>(&spec.data(), spec.settings, AccelChoice::Linear, |_| ())
+        .map(|_| ())
+        .map_err(|e| spec.explain(&e, "f32"))
+}
+
+/// Turns parsed entries into owned scene data: names to indices, meshes read and placed.
+fn resolve(file: SceneFile, path: &Path, stem: &str) -> Result<SceneSpec, Error> {
+    let err = |field: String, msg: String| Error::Scene {
+        file: path.display().to_string(),
+        field,
+        msg,
+    };
+    let mut materials = Vec::with_capacity(file.materials.len());
+    let mut names: Vec<String> = Vec::with_capacity(file.materials.len());
+    for (i, m) in file.materials.iter().enumerate() {
+        let here = format!("materials[{i}] ({:?})", m.name);
+        if names.contains(&m.name) {
+            return Err(err(
+                here,
+                "duplicate name: material names must be unique".into(),
+            ));
+        }
+        let kinds = [
+            m.diffuse.map(|d| Material::Diffuse { albedo: d.albedo }),
+            m.mirror.map(|d| Material::Mirror {
+                reflectance: d.reflectance,
+            }),
+            m.glossy.map(|d| Material::Glossy {
+                reflectance: d.reflectance,
+                exponent: d.exponent,
+            }),
+            m.emissive.map(|d| Material::Emissive {
+                radiance: d.radiance,
+            }),
+        ];
+        let mut given = kinds.iter().flatten();
+        match (given.next(), given.next()) {
+            (Some(k), None) => materials.push(*k),
+            _ => {
+                return Err(err(
+                    here,
+                    "expected exactly one of `diffuse`, `mirror`, `glossy`, `emissive`".into(),
+                ))
+            }
+        }
+        names.push(m.name.clone());
+    }
+
+    let base = path.parent().unwrap_or(Path::new("."));
+    let mut spec = SceneSpec {
+        name: file.name.clone().unwrap_or_else(|| stem.to_string()),
+        origin: SceneOrigin::File(path.to_path_buf()),
+        triangles: Vec::new(),
+        spheres: Vec::new(),
+        objects: Vec::with_capacity(file.objects.len()),
+        object_sources: Vec::with_capacity(file.objects.len()),
+        materials,
+        material_names: names,
+        lights: file.lights.iter().map(|l| light(*l)).collect(),
+        camera: camera(&file.camera),
+        background: file.background,
+        settings: settings(&file.settings, DEFAULT_SETTINGS),
+    };
+    for (i, o) in file.objects.iter().enumerate() {
+        let here = |field: &str| format!("objects[{i}]{field}");
+        let Some(material) = spec.material_names.iter().position(|n| *n == o.material) else {
+            let known = spec
+                .material_names
+                .iter()
+                .map(|n| format!("{n:?}"))
+                .collect::<Vec<_>>()
+                .join(", ");
+            return Err(err(
+                here(".material"),
+                format!("no material named {:?} (materials: {known})", o.material),
+            ));
+        };
+        let transform = o.transform.unwrap_or_default();
+        let first_tri = spec.triangles.len();
+        let (shape, source) = match (&o.mesh, &o.triangles, &o.spheres) {
+            (Some(mesh), None, None) => {
+                let obj_path = base.join(mesh);
+                let m = load_obj(&obj_path).map_err(|e| err(here(".mesh"), e.to_string()))?;
+                let mut lines = Vec::with_capacity(m.triangle_count());
+                for (t, corners) in m.triangles.iter().enumerate() {
+                    spec.triangles
+                        .push(m.triangle_f32(t).map(|p| transform.apply(p)));
+                    lines.push(corners.map(|c| m.position_lines[c as usize]));
+                }
+                let source = ObjectSource::Mesh {
+                    path: obj_path,
+                    vertex_lines: lines,
+                };
+                (tri_range(first_tri, spec.triangles.len()), source)
+            }
+            (None, Some(tris), None) => {
+                spec.triangles
+                    .extend(tris.iter().map(|t| t.map(|p| transform.apply(p))));
+                (
+                    tri_range(first_tri, spec.triangles.len()),
+                    ObjectSource::Inline,
+                )
+            }
+            (None, None, Some(spheres)) => {
+                if o.transform.is_some() {
+                    return Err(err(
+                        here(".transform"),
+                        "applies to `mesh` and `triangles` objects only (place spheres by \
+                         their centres)"
+                            .into(),
+                    ));
+                }
+                let first = spec.spheres.len();
+                spec.spheres.extend(spheres.iter().map(|s| SphereData {
+                    center: s.center,
+                    radius: s.radius,
+                }));
+                let shape = ShapeRange::Spheres {
+                    first: index_u32(first),
+                    count: index_u32(spheres.len()),
+                };
+                (shape, ObjectSource::Inline)
+            }
+            _ => {
+                return Err(err(
+                    here(""),
+                    "expected exactly one of `mesh`, `triangles`, `spheres`".into(),
+                ))
+            }
+        };
+        spec.objects.push(ObjectData {
+            shape,
+            material: index_u32(material),
+            motion: o.motion.unwrap_or([0.0; 3]),
+        });
+        spec.object_sources.push(source);
+    }
+    Ok(spec)
+}
+
+/// Indices into host vectors fit `u32` for any scene that fits in memory; saturate otherwise
+/// (the kernel then reports the range as out of bounds).
+fn index_u32(i: usize) -> u32 {
+    u32::try_from(i).unwrap_or(u32::MAX)
+}
+
+fn tri_range(first: usize, end: usize) -> ShapeRange {
+    ShapeRange::Triangles {
+        first: index_u32(first),
+        count: index_u32(end - first),
+    }
+}
+
+fn camera(c: &CameraEntry) -> Camera {
+    let focus = c.focus_distance.unwrap_or_else(|| {
+        let d: [f64; 3] = std::array::from_fn(|k| f64::from(c.look_at[k] - c.eye[k]));
+        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() as f32
+    });
+    Camera {
+        eye: c.eye,
+        look_at: c.look_at,
+        up: c.up,
+        vfov_deg: c.vfov_deg,
+        aperture_radius: c.aperture_radius,
+        focus_distance: focus,
+    }
+}
+
+/// `entry`'s settings over `base`.
+#[must_use]
+pub fn settings(entry: &SettingsEntry, base: Settings) -> Settings {
+    Settings {
+        width: entry.width.unwrap_or(base.width),
+        height: entry.height.unwrap_or(base.height),
+        spp: entry.spp.unwrap_or(base.spp),
+        max_depth: entry.max_depth.unwrap_or(base.max_depth),
+        sampler: entry.sampler.map_or(base.sampler, Into::into),
+        filter: entry.filter.map_or(base.filter, Into::into),
+        seed: entry.seed.unwrap_or(base.seed),
+    }
+}
+
+fn light(l: LightEntry) -> Light {
+    match l {
+        LightEntry::Point {
+            position,
+            intensity,
+        } => Light::Point {
+            position,
+            intensity,
+        },
+        LightEntry::Rect {
+            corner,
+            edge_u,
+            edge_v,
+            radiance,
+        } => Light::Rect {
+            corner,
+            edge_u,
+            edge_v,
+            radiance,
+        },
+        LightEntry::Sphere {
+            center,
+            radius,
+            radiance,
+        } => Light::Sphere {
+            center,
+            radius,
+            radiance,
+        },
+    }
+}
+
+/// The scene-file form of kernel scene data: geometry inline, materials named by
+/// `material_names` (or `m0`, `m1`, ... where absent), every setting written out.
+#[must_use]
+pub fn to_scene_file(d: &SceneData<'_>, material_names: &[String]) -> SceneFile {
+    let name = |i: usize| {
+        material_names
+            .get(i)
+            .cloned()
+            .unwrap_or_else(|| format!("m{i}"))
+    };
+    let materials = d
+        .materials
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let mut e = MaterialEntry {
+                name: name(i),
+                diffuse: None,
+                mirror: None,
+                glossy: None,
+                emissive: None,
+            };
+            match *m {
+                Material::Diffuse { albedo } => e.diffuse = Some(Diffuse { albedo }),
+                Material::Mirror { reflectance } => e.mirror = Some(Mirror { reflectance }),
+                Material::Glossy {
+                    reflectance,
+                    exponent,
+                } => {
+                    e.glossy = Some(Glossy {
+                        reflectance,
+                        exponent,
+                    });
+                }
+                Material::Emissive { radiance } => e.emissive = Some(Emissive { radiance }),
+            }
+            e
+        })
+        .collect();
+    let slice = |first: u32, count: u32, len: usize| {
+        let a = (first as usize).min(len);
+        a..(a + count as usize).min(len)
+    };
+    let objects = d
+        .objects
+        .iter()
+        .map(|o| {
+            let (triangles, spheres) = match o.shape {
+                ShapeRange::Triangles { first, count } => (
+                    Some(d.triangles[slice(first, count, d.triangles.len())].to_vec()),
+                    None,
+                ),
+                ShapeRange::Spheres { first, count } => (
+                    None,
+                    Some(
+                        d.spheres[slice(first, count, d.spheres.len())]
+                            .iter()
+                            .map(|s| SphereEntry {
+                                center: s.center,
+                                radius: s.radius,
+                            })
+                            .collect(),
+                    ),
+                ),
+            };
+            ObjectEntry {
+                mesh: None,
+                triangles,
+                spheres,
+                transform: None,
+                material: name(o.material as usize),
+                motion: (o.motion != [0.0; 3]).then_some(o.motion),
+            }
+        })
+        .collect();
+    let lights = d
+        .lights
+        .iter()
+        .map(|l| match *l {
+            Light::Point {
+                position,
+                intensity,
+            } => LightEntry::Point {
+                position,
+                intensity,
+            },
+            Light::Rect {
+                corner,
+                edge_u,
+                edge_v,
+                radiance,
+            } => LightEntry::Rect {
+                corner,
+                edge_u,
+                edge_v,
+                radiance,
+            },
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } => LightEntry::Sphere {
+                center,
+                radius,
+                radiance,
+            },
+        })
+        .collect();
+    let s = d.settings;
+    let c = d.camera;
+    SceneFile {
+        format: FORMAT.into(),
+        version: VERSION,
+        name: Some(d.name.to_string()),
+        camera: CameraEntry {
+            eye: c.eye,
+            look_at: c.look_at,
+            up: c.up,
+            vfov_deg: c.vfov_deg,
+            aperture_radius: c.aperture_radius,
+            focus_distance: Some(c.focus_distance),
+        },
+        background: d.background,
+        settings: SettingsEntry {
+            width: Some(s.width),
+            height: Some(s.height),
+            spp: Some(s.spp),
+            max_depth: Some(s.max_depth),
+            sampler: Some(s.sampler.into()),
+            filter: Some(s.filter.into()),
+            seed: Some(s.seed),
+        },
+        materials,
+        objects,
+        lights,
+    }
+}
+
+/// The scene file text of `d` (see [`to_scene_file`]): pretty-printed, with number arrays
+/// (points, colours, triangles) kept on one line, every `f32` written in its shortest
+/// round-trip form.
+#[must_use]
+pub fn dump(d: &SceneData<'_>, material_names: &[String]) -> String {
+    // A struct of numbers, strings and options: serialization cannot fail.
+    let value = serde_json::to_value(to_scene_file(d, material_names)).unwrap_or(Value::Null);
+    let mut out = String::new();
+    pretty(&value, 0, &mut out);
+    out.push('\n');
+    out
+}
+
+/// Writes `d` as a scene file.
+///
+/// # Errors
+/// [`Error::Output`] if the file cannot be written.
+pub fn write_scene_file(path: &Path, d: &SceneData<'_>, names: &[String]) -> Result<(), Error> {
+    std::fs::write(path, dump(d, names)).map_err(|e| Error::Output {
+        path: PathBuf::from(path),
+        msg: format!("cannot write: {e}"),
+    })
+}
+
+/// True for a number, or an array of numbers, or an array of arrays of numbers.
+fn flat(v: &Value, depth: u32) -> bool {
+    match v {
+        Value::Number(_) => true,
+        Value::Array(a) => depth < 2 && a.iter().all(|x| flat(x, depth + 1)),
+        _ => false,
+    }
+}
+
+fn pretty(v: &Value, indent: usize, out: &mut String) {
+    let pad = |n: usize| "  ".repeat(n);
+    match v {
+        Value::Object(map) if !map.is_empty() => {
+            out.push_str("{\n");
+            for (i, (k, x)) in map.iter().enumerate() {
+                out.push_str(&pad(indent + 1));
+                out.push_str(&Value::String(k.clone()).to_string());
+                out.push_str(": ");
+                pretty(x, indent + 1, out);
+                out.push_str(if i + 1 < map.len() { ",\n" } else { "\n" });
+            }
+            out.push_str(&pad(indent));
+            out.push('}');
+        }
+        Value::Array(a) if !a.is_empty() && !flat(v, 0) => {
+            out.push_str("[\n");
+            for (i, x) in a.iter().enumerate() {
+                out.push_str(&pad(indent + 1));
+                pretty(x, indent + 1, out);
+                out.push_str(if i + 1 < a.len() { ",\n" } else { "\n" });
+            }
+            out.push_str(&pad(indent));
+            out.push(']');
+        }
+        Value::Array(a) => {
+            out.push('[');
+            for (i, x) in a.iter().enumerate() {
+                if i > 0 {
+                    out.push_str(", ");
+                }
+                pretty(x, indent, out);
+            }
+            out.push(']');
+        }
+        // Every float in a scene file is an f32 widened to f64 (exactly): print the f32's
+        // shortest round-trip form.
+        Value::Number(n) if n.is_f64() => {
+            let x = n.as_f64().unwrap_or(0.0) as f32;
+            out.push_str(&format!("{x:?}"));
+        }
+        other => out.push_str(&other.to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transform_scales_rotates_then_translates() {
+        let t = Transform {
+            scale: Some(Scale::Uniform(2.0)),
+            rotate_deg: Some([0.0, 90.0, 0.0]),
+            translate: Some([1.0, 0.0, 0.0]),
+        };
+        // (1,0,0) -> (2,0,0) -> about y by 90°: x -> -z -> (0,0,-2) -> (1,0,-2).
+        let p = t.apply([1.0, 0.0, 0.0]);
+        assert!((p[0] - 1.0).abs() < 1e-6 && p[1] == 0.0 && (p[2] + 2.0).abs() < 1e-6);
+        // About z by 90°: x -> y.
+        let z = Transform {
+            rotate_deg: Some([0.0, 0.0, 90.0]),
+            ..Transform::default()
+        };
+        let q = z.apply([1.0, 0.0, 0.0]);
+        assert!(q[0].abs() < 1e-6 && (q[1] - 1.0).abs() < 1e-6);
+        assert_eq!(Transform::default().apply([0.1, 0.2, 0.3]), [0.1, 0.2, 0.3]);
+    }
+
+    #[test]
+    fn dump_prints_short_floats_and_inline_arrays() {
+        let d = raykernel::render::scenes::CORNELL;
+        let text = dump(&d, &[]);
+        assert!(text.contains("\"albedo\": [0.73, 0.73, 0.73]"), "{text}");
+        assert!(text.contains("[[-1.0, 0.0, -1.0], [-1.0, 0.0, 1.0], [1.0, 0.0, 1.0]]"));
+        assert!(text.contains("\"sampler\": \"stratified\""));
+    }
+}

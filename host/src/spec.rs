@@ -1,0 +1,212 @@
+//! [`SceneSpec`]: a scene the host owns (built-in, loaded from a scene file, or made from an
+//! OBJ), lending the kernel's plain-data view [`SceneData`], and turning the kernel's typed
+//! [`SceneError`]s back into messages that name the file and the field the user wrote.
+
+use crate::error::Error;
+use crate::obj::{ObjError, ObjErrorKind};
+use raykernel::render::scenes::{ObjectData, SceneData, ShapeRange, SphereData};
+use raykernel::render::{Camera, Item, Light, Material, Problem, Rgb, SceneError, Settings};
+use raykernel::BuildError;
+use std::path::PathBuf;
+
+/// Where an object's geometry came from (for error messages).
+#[derive(Clone, Debug, PartialEq)]
+pub enum ObjectSource {
+    /// Written in the scene (inline triangles or spheres, or a built-in scene).
+    Inline,
+    /// Read from an OBJ file: the line of each corner of each triangle, in triangle order.
+    Mesh {
+        /// The OBJ file.
+        path: PathBuf,
+        /// `vertex_lines[t][c]`: the line defining corner `c` of the object's triangle `t`.
+        vertex_lines: Vec<[usize; 3]>,
+    },
+}
+
+/// Where a whole scene came from: decides how errors are worded.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SceneOrigin {
+    /// A built-in scene of the kernel.
+    BuiltIn,
+    /// A scene file (errors name its JSON fields).
+    File(PathBuf),
+    /// An OBJ file rendered with the host's default materials, lights and camera.
+    Obj(PathBuf),
+}
+
+/// A scene as owned `f32` data: the same shape as the kernel's [`SceneData`], plus the names and
+/// sources error messages need. Object `i`, material `i` and light `i` are entry `i` of the
+/// scene file's lists.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneSpec {
+    /// Short name (reports, file names).
+    pub name: String,
+    /// Where it came from.
+    pub origin: SceneOrigin,
+    /// Every triangle; objects' ranges index into it.
+    pub triangles: Vec<[[f32; 3]; 3]>,
+    /// Every sphere.
+    pub spheres: Vec<SphereData>,
+    /// Objects.
+    pub objects: Vec<ObjectData>,
+    /// Where each object came from.
+    pub object_sources: Vec<ObjectSource>,
+    /// Materials.
+    pub materials: Vec<Material>,
+    /// The name of each material.
+    pub material_names: Vec<String>,
+    /// Lights.
+    pub lights: Vec<Light>,
+    /// Camera.
+    pub camera: Camera,
+    /// Background radiance.
+    pub background: Rgb,
+    /// Settings to render with.
+    pub settings: Settings,
+}
+
+impl SceneSpec {
+    /// An owned copy of kernel scene data (a built-in scene); materials are named `m0`, `m1`, ...
+    #[must_use]
+    pub fn from_data(d: &SceneData<'_>) -> Self {
+        Self {
+            name: d.name.to_string(),
+            origin: SceneOrigin::BuiltIn,
+            triangles: d.triangles.to_vec(),
+            spheres: d.spheres.to_vec(),
+            objects: d.objects.to_vec(),
+            object_sources: vec![ObjectSource::Inline; d.objects.len()],
+            materials: d.materials.to_vec(),
+            material_names: (0..d.materials.len()).map(|i| format!("m{i}")).collect(),
+            lights: d.lights.to_vec(),
+            camera: d.camera,
+            background: d.background,
+            settings: d.settings,
+        }
+    }
+
+    /// The kernel's view of this scene.
+    #[must_use]
+    pub fn data(&self) -> SceneData<'_> {
+        SceneData {
+            name: &self.name,
+            triangles: &self.triangles,
+            spheres: &self.spheres,
+            objects: &self.objects,
+            materials: &self.materials,
+            lights: &self.lights,
+            camera: self.camera,
+            background: self.background,
+            settings: self.settings,
+        }
+    }
+
+    /// How messages name this scene: the file, or `built-in scene NAME`.
+    #[must_use]
+    pub fn label(&self) -> String {
+        match &self.origin {
+            SceneOrigin::BuiltIn => format!("built-in scene `{}`", self.name),
+            SceneOrigin::File(p) | SceneOrigin::Obj(p) => p.display().to_string(),
+        }
+    }
+
+    /// Turns a kernel error on this scene (rendered in `mode`) into a message naming the file,
+    /// the field as written in the scene file, and the problem, e.g.
+    /// `scene.json: materials[2] ("gold").reflectance: must be at most 1`.
+    #[must_use]
+    pub fn explain(&self, e: &SceneError, mode: &'static str) -> Error {
+        let at = |field: String, msg: String| Error::Scene {
+            file: self.label(),
+            field,
+            msg,
+        };
+        let problem = e.problem.to_string();
+        let i = e.index;
+        match e.item {
+            Item::Material => {
+                let name = self
+                    .material_names
+                    .get(i)
+                    .map_or(String::new(), |n| format!(" ({n:?})"));
+                at(format!("materials[{i}]{name}.{}", e.field), problem)
+            }
+            Item::Light => {
+                if e.field == "lights" {
+                    at("lights".into(), problem)
+                } else {
+                    at(format!("lights[{i}].{}", e.field), problem)
+                }
+            }
+            Item::Camera => at(format!("camera.{}", e.field), problem),
+            Item::Settings if e.field == "background" => at("background".into(), problem),
+            Item::Settings => at(format!("settings.{}", e.field), problem),
+            Item::Tile => at(format!("tile.{}", e.field), problem),
+            Item::Object => self.explain_object(e, mode),
+        }
+    }
+
+    fn explain_object(&self, e: &SceneError, mode: &'static str) -> Error {
+        let at = |field: String, msg: String| Error::Scene {
+            file: self.label(),
+            field,
+            msg,
+        };
+        let i = e.index;
+        if matches!(e.field, "objects" | "nodes" | "prim_ids") {
+            return at(e.field.into(), e.problem.to_string());
+        }
+        let Problem::Build(BuildError::BadPrimitive {
+            prim,
+            vertex,
+            error,
+        }) = e.problem
+        else {
+            return at(format!("objects[{i}].{}", e.field), e.problem.to_string());
+        };
+        // `triangles_into`/`spheres_into` report the global primitive index, the accelerator
+        // build (field `shape`) the object's own.
+        let (first, spheres) = match self.objects.get(i).map(|o| o.shape) {
+            Some(ShapeRange::Triangles { first, .. }) => (first as usize, false),
+            Some(ShapeRange::Spheres { first, .. }) => (first as usize, true),
+            None => (0, false),
+        };
+        let local = if e.field == "shape" {
+            prim
+        } else {
+            prim.saturating_sub(first)
+        };
+        if spheres {
+            let field = if vertex == 0 { "center" } else { "radius" };
+            return at(format!("objects[{i}].spheres[{local}].{field}"), {
+                format!("{error} (in {mode} mode)")
+            });
+        }
+        match self.object_sources.get(i) {
+            Some(ObjectSource::Mesh { path, vertex_lines }) => {
+                let line = vertex_lines
+                    .get(local)
+                    .and_then(|l| l.get(vertex))
+                    .copied()
+                    .unwrap_or(0);
+                let obj = ObjError::at(
+                    path,
+                    line,
+                    ObjErrorKind::UnusableVertex {
+                        triangle: local,
+                        mode,
+                        error,
+                    },
+                );
+                if let SceneOrigin::File(_) = self.origin {
+                    at(format!("objects[{i}].mesh"), obj.to_string())
+                } else {
+                    Error::Obj(obj)
+                }
+            }
+            _ => at(
+                format!("objects[{i}].triangles[{local}][{vertex}]"),
+                format!("{error} (in {mode} mode)"),
+            ),
+        }
+    }
+}
