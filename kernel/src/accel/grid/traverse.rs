@@ -32,8 +32,10 @@ impl<S: Scalar> Layout<S> {
         S::slab_axis(rd, axis, self.plane(axis, i), self.plane(axis, i + 1))
     }
 
-    /// The walk state of `axis` at `t`: binary searches over the monotone entries and exits.
-    fn start(&self, rd: &S::RayData, axis: usize, t: S) -> AxisWalk<S> {
+    /// The walk state of `axis` at `t`. The search starts from `guess` (a walk position
+    /// estimated from the entry point) and steps over the monotone entries and exits, so it
+    /// is exact whatever the guess; a good guess makes it a few steps.
+    fn start(&self, rd: &S::RayData, axis: usize, t: S, guess: u32) -> AxisWalk<S> {
         let mut w = AxisWalk {
             n: self.res[axis.min(2)],
             negative: S::axis_negative(rd, axis),
@@ -42,21 +44,21 @@ impl<S: Scalar> Layout<S> {
             next: t,
             lo_exit: t,
         };
-        // end = number of cells entered by t; lo = number of cells left before t.
-        let count = |pred: &dyn Fn(u32) -> bool| {
-            let (mut l, mut h) = (0u32, w.n);
-            while l < h {
-                let mid = l + (h - l) / 2;
-                if pred(mid) {
-                    l = mid + 1;
-                } else {
-                    h = mid;
-                }
-            }
-            l
-        };
-        w.end = count(&|m| self.interval(rd, axis, &w, m).0 <= t);
-        w.lo = count(&|m| self.interval(rd, axis, &w, m).1 < t).min(w.end);
+        // end = number of cells entered by t (entries are nondecreasing in m).
+        let mut end = guess.min(w.n);
+        while end < w.n && self.interval(rd, axis, &w, end).0 <= t {
+            end += 1;
+        }
+        while end > 0 && self.interval(rd, axis, &w, end - 1).0 > t {
+            end -= 1;
+        }
+        // lo = number of cells left before t (exits are nondecreasing; such cells were entered).
+        let mut lo = end;
+        while lo > 0 && self.interval(rd, axis, &w, lo - 1).1 >= t {
+            lo -= 1;
+        }
+        w.end = end;
+        w.lo = lo;
         if w.end < w.n {
             w.next = self.interval(rd, axis, &w, w.end).0;
         }
@@ -64,6 +66,26 @@ impl<S: Scalar> Layout<S> {
             w.lo_exit = self.interval(rd, axis, &w, w.lo).1;
         }
         w
+    }
+
+    /// A guess of the walk position of the cell holding `origin + t·dir` on `axis` (only the
+    /// speed of [`Layout::start`] depends on it).
+    fn guess(&self, rd: &S::RayData, axis: usize, t: S, negative: bool) -> u32 {
+        let a = axis.min(2);
+        let n = self.res[a];
+        let (o, d) = (S::ray_origin(rd)[a].to_f32(), S::ray_dir(rd)[a].to_f32());
+        let tf = t.to_f32();
+        let x = if tf.is_finite() { o + tf * d } else { o };
+        let s = self.step[a];
+        let i = if s > 0.0 { (x - self.lo_f[a]) / s } else { 0.0 };
+        // Saturating cast (NaN -> 0), then clamped to a cell.
+        let i = (i as i64).clamp(0, n as i64 - 1) as u32;
+        // One past the cell: `start` steps back over cells not yet entered.
+        if negative {
+            n - i
+        } else {
+            i + 1
+        }
     }
 
     /// Drops the cells of `axis` that end before `t`.
@@ -182,7 +204,11 @@ impl<S: Scalar, P: Primitive<S>> Grid<'_, S, P> {
         let Some(t0) = S::slab(rd, &l.lo, &l.hi, q.t_min, q.best_t) else {
             return (q.best_t, q.best_prim);
         };
-        let mut walks = [l.start(rd, 0, t0), l.start(rd, 1, t0), l.start(rd, 2, t0)];
+        let walks: [AxisWalk<S>; 3] = core::array::from_fn(|a| {
+            let guess = l.guess(rd, a, t0, S::axis_negative(rd, a));
+            l.start(rd, a, t0, guess)
+        });
+        let mut walks = walks;
         let ranges = walks.map(|w| (w.lo, w.end));
         if self.visit_block::<ANY, C>(&mut q, &walks, ranges, stats) {
             return (q.best_t, q.best_prim);

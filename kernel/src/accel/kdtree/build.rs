@@ -10,7 +10,7 @@ use crate::scalar::Scalar;
 /// Candidate planes per axis (bins of the node's extent).
 const BINS: usize = 32;
 /// SAH cost of a traversal step, relative to one primitive test.
-const TRAVERSAL_COST: f32 = 1.0;
+const TRAVERSAL_COST: f32 = 2.0;
 /// SAH cost of a primitive test.
 const INTERSECT_COST: f32 = 1.5;
 /// Discount on the split cost when one side is empty (cutting off empty space).
@@ -66,6 +66,10 @@ struct Pending<S: Scalar> {
     hi: [S; 3],
     start: usize,
     end: usize,
+    /// References this subtree may add (its share of the reference budget's slack).
+    ref_slack: usize,
+    /// Nodes this subtree may add below this node.
+    node_slack: usize,
 }
 
 pub(super) fn build<S: Scalar, P: Primitive<S>>(
@@ -137,6 +141,8 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
         hi: bounds.hi,
         start: root_start,
         end: ref_budget,
+        ref_slack: ref_budget - n,
+        node_slack: node_budget - 1,
     }; MAX_DEPTH as usize + 2];
     let mut sp = 1usize;
     let mut used = 1usize;
@@ -150,18 +156,21 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
         };
         deepest = deepest.max(job.depth);
         let count = job.end - job.start;
-        let split = if count > 1 && job.depth < max_depth && used + 2 <= node_budget {
-            refs.get(job.start..job.end)
-                .and_then(|list| builder.sah(list, &job.lo, &job.hi))
-        } else {
-            None
-        };
+        let split =
+            if count > 1 && job.depth < max_depth && job.node_slack >= 2 && used + 2 <= node_budget
+            {
+                refs.get(job.start..job.end)
+                    .and_then(|list| builder.sah(list, &job.lo, &job.hi))
+            } else {
+                None
+            };
         // Partition into [below only | both | above only]; split if the straddling
         // references fit between the finished leaves and this list.
         let mut made = None;
         if let (Some((axis, plane)), Some(list)) = (split, refs.get_mut(job.start..job.end)) {
             let (below, both) = builder.partition(list, axis, plane);
-            if both <= job.start - front && (below + both < count || count - below < count) {
+            let fits = both <= job.ref_slack && both <= job.start - front;
+            if fits && (below + both < count || count - below < count) {
                 made = Some((axis, plane, below, both));
             }
         }
@@ -184,6 +193,20 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
         if let Some(node) = nodes.get_mut(job.node as usize) {
             *node = KdNode::inner(axis, plane, l as u32);
         }
+        // The subtree's remaining slack goes to the children in proportion to their lists,
+        // so the budget is shared fairly rather than spent by whichever side is built first.
+        let share = |slack: usize, part: usize, whole: usize| -> usize {
+            if whole == 0 {
+                0
+            } else {
+                (slack as u128 * part as u128 / whole as u128) as usize
+            }
+        };
+        let (n_below, n_above) = (below + both, count - below);
+        let refs_left = job.ref_slack - both;
+        let nodes_left = job.node_slack - 2;
+        let below_refs = share(refs_left, n_below, n_below + n_above);
+        let below_nodes = share(nodes_left, n_below, n_below + n_above);
         let a = axis.min(2);
         let mut below_hi = job.hi;
         below_hi[a] = plane;
@@ -197,6 +220,8 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
                 hi: job.hi,
                 start: mid,
                 end: job.end,
+                ref_slack: refs_left - below_refs,
+                node_slack: nodes_left - below_nodes,
             },
             Pending {
                 node: l as u32,
@@ -205,6 +230,8 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
                 hi: below_hi,
                 start,
                 end: mid,
+                ref_slack: below_refs,
+                node_slack: below_nodes,
             },
         ];
         // Above pushed first: the lower child (whose list is lower in memory) is done next.
@@ -259,27 +286,40 @@ impl<P> Builder<'_, P> {
         }
         let leaf_cost = INTERSECT_COST * count as f32;
         let nb = (2 * count).clamp(4, BINS);
+        let scale: [f32; 3] = core::array::from_fn(|a| {
+            if ext[a] > 0.0 {
+                nb as f32 / ext[a]
+            } else {
+                0.0
+            }
+        });
+        let bin = |x: f32, a: usize| -> usize {
+            let a = a.min(2);
+            // Saturating cast (NaN -> 0), then clamped: always a valid bin.
+            (((x - lo_f[a]) * scale[a]) as i64).clamp(0, nb as i64 - 1) as usize
+        };
+        // Per axis: primitives whose clipped box starts / ends in each bin.
+        let mut starts = [[0u32; BINS]; 3];
+        let mut ends = [[0u32; BINS]; 3];
+        for &id in list {
+            let b = self.bounds::<S>(id);
+            for a in 0..3 {
+                let x0 = b.lo[a].max_of(lo[a]).to_f32();
+                let x1 = b.hi[a].min_of(hi[a]).to_f32();
+                // `% BINS`: a no-op (bins < nb <= BINS) that shows the compiler the bound.
+                starts[a][bin(x0, a) % BINS] += 1;
+                ends[a][bin(x1, a) % BINS] += 1;
+            }
+        }
         let mut best: Option<(f32, usize, S)> = None;
         for a in 0..3 {
             if !(ext[a] > 0.0) {
                 continue;
             }
-            let scale = nb as f32 / ext[a];
-            let bin = |x: f32| ((x - lo_f[a]) * scale).clamp(0.0, nb as f32 - 1.0) as usize;
-            let mut starts = [0u32; BINS];
-            let mut ends = [0u32; BINS];
-            for &id in list {
-                let b = self.bounds::<S>(id);
-                let x0 = b.lo[a].max_of(lo[a]).to_f32();
-                let x1 = b.hi[a].min_of(hi[a]).to_f32();
-                // `% BINS`: a no-op (bins < nb <= BINS) that shows the compiler the bound.
-                starts[bin(x0) % BINS] += 1;
-                ends[bin(x1) % BINS] += 1;
-            }
             let (mut n_below, mut ended) = (0u32, 0u32);
             for b in 0..nb - 1 {
-                n_below += starts[b % BINS];
-                ended += ends[b % BINS];
+                n_below += starts[a][b % BINS];
+                ended += ends[a][b % BINS];
                 let n_above = count as u32 - ended;
                 let pos = lo_f[a] + (b + 1) as f32 * (ext[a] / nb as f32);
                 let mut d_below = ext;

@@ -13,9 +13,11 @@
 //! capacity, so the stack cannot overflow.
 //!
 //! **Memory bound (by construction).** The tree never uses more than [`nodes_needed`]`(n)`
-//! nodes and [`refs_needed`]`(n)` primitive references: before each split the builder checks
-//! that the two new nodes and the duplicated references (primitives straddling the plane) fit
-//! those budgets, and makes a leaf otherwise. The references live in one slice: finished
+//! nodes and [`refs_needed`]`(n)` primitive references: every pending node carries a share of
+//! what is left of both budgets (the root gets all of it; a split spends two nodes and one
+//! reference per primitive straddling the plane, and divides the rest between the children in
+//! proportion to their primitive counts, so one side cannot starve the other), and a node whose
+//! split does not fit its share becomes a leaf. The references live in one slice: finished
 //! leaves' lists grow from the front, lists still to be split sit at the back in stack order,
 //! and a split only moves one list down by the number of straddling primitives; so the peak
 //! use equals the final use and no scratch memory is needed. [`KdTree::build`] fails with
@@ -41,11 +43,11 @@ use core::marker::PhantomData;
 /// Deepest level a leaf may sit at (root = 0); also the traversal stack's capacity.
 pub const MAX_DEPTH: u32 = 40;
 /// References reserved per primitive by [`refs_needed`]: the duplication budget.
-pub const REFS_PER_PRIM: usize = 4;
+pub const REFS_PER_PRIM: usize = 6;
 /// Nodes reserved per primitive by [`nodes_needed`].
-pub const NODES_PER_PRIM: usize = 3;
+pub const NODES_PER_PRIM: usize = 4;
 
-/// Node slots the builder may use for `prim_count` primitives: `3n + 1` (0 for none).
+/// Node slots the builder may use for `prim_count` primitives: `4n + 1` (0 for none).
 #[must_use]
 pub const fn nodes_needed(prim_count: usize) -> usize {
     if prim_count == 0 {
@@ -55,7 +57,7 @@ pub const fn nodes_needed(prim_count: usize) -> usize {
     }
 }
 
-/// Reference slots the builder may use for `prim_count` primitives: `4n`.
+/// Reference slots the builder may use for `prim_count` primitives: `6n`.
 #[must_use]
 pub const fn refs_needed(prim_count: usize) -> usize {
     prim_count.saturating_mul(REFS_PER_PRIM)
