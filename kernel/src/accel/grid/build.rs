@@ -262,7 +262,10 @@ pub(super) fn validate<S: Scalar, P: Primitive<S>>(
         return Err(InvalidGrid::BadOffsets { cell: 0 });
     }
     for (c, w) in grid.cells.windows(2).enumerate() {
-        let (start, end) = (w[0] as usize, w[1] as usize);
+        let &[start, end] = w else {
+            return Err(InvalidGrid::BadOffsets { cell: c });
+        };
+        let (start, end) = (start as usize, end as usize);
         if start > end || end > grid.refs.len() {
             return Err(InvalidGrid::BadOffsets { cell: c });
         }

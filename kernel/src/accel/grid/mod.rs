@@ -132,7 +132,7 @@ impl<S: Scalar> Layout<S> {
                 0.0
             };
             // Saturating cast (NaN -> 0), then clamped to a cell.
-            (e as i64).clamp(0, n as i64 - 1) as u32
+            (e as i64).max(0).min(n as i64 - 1) as u32
         };
         let mut first = estimate(x_lo);
         while first > 0 && self.plane(a, first) > x_lo {

@@ -22,7 +22,7 @@ struct AxisWalk<S> {
 
 impl<S: Scalar> Layout<S> {
     /// `(entry, exit)` of the `m`-th cell the ray meets along `axis`.
-    #[inline(always)]
+    #[inline]
     fn interval(&self, rd: &S::RayData, axis: usize, walk: &AxisWalk<S>, m: u32) -> (S, S) {
         let i = if walk.negative {
             walk.n.saturating_sub(1).saturating_sub(m)
@@ -79,17 +79,17 @@ impl<S: Scalar> Layout<S> {
         let s = self.step[a];
         let i = if s > 0.0 { (x - self.lo_f[a]) / s } else { 0.0 };
         // Saturating cast (NaN -> 0), then clamped to a cell.
-        let i = (i as i64).clamp(0, n as i64 - 1) as u32;
+        let i = (i as i64).min(n as i64 - 1).max(0) as u32;
         // One past the cell: `start` steps back over cells not yet entered.
         if negative {
-            n - i
+            n.saturating_sub(i)
         } else {
             i + 1
         }
     }
 
     /// Drops the cells of `axis` that end before `t`.
-    #[inline(always)]
+    #[inline]
     fn retire(&self, rd: &S::RayData, axis: usize, w: &mut AxisWalk<S>, t: S) {
         while w.lo < w.end && w.lo_exit < t {
             w.lo += 1;
@@ -159,8 +159,9 @@ impl<S: Scalar, P: Primitive<S>> Grid<'_, S, P> {
         false
     }
 
-    /// Visits the cells `xs × ys × zs` (walk positions); true if `ANY` found a hit.
-    #[inline(always)]
+    /// Visits the cells `xs × ys × zs` (walk positions); true if `ANY` found a hit. Not
+    /// inlined: one copy of the primitive test per query type keeps the code small.
+    #[inline(never)]
     fn visit_block<const ANY: bool, C: Counters>(
         &self,
         q: &mut Query<'_, S>,

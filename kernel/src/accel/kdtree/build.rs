@@ -176,7 +176,7 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
         }
         let Some((axis, plane, below, both)) = made else {
             // Leaf: move the list to the front.
-            refs.copy_within(job.start..job.end, front);
+            move_within(refs, job.start, job.end, front);
             if let Some(node) = nodes.get_mut(job.node as usize) {
                 *node = KdNode::leaf(front as u32, count as u32);
             }
@@ -186,7 +186,7 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
         // Duplicate the straddlers: [below | both] moves down by `both`, leaving a copy of
         // `both` in place for the upper child: [below | both] [both | above].
         let start = job.start - both;
-        refs.copy_within(job.start..job.start + below + both, start);
+        move_within(refs, job.start, job.start + below + both, start);
         let mid = job.start + below;
         let l = used;
         used += 2;
@@ -250,6 +250,20 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
     })
 }
 
+/// Copies `v[from..to]` down to `v[dest..]` (`dest <= from`, so a forward copy is right even
+/// when the ranges overlap). Element by element through `get`: callers pass proven ranges,
+/// and this keeps `copy_within`'s panic path out of the code.
+fn move_within(v: &mut [u32], from: usize, to: usize, dest: usize) {
+    debug_assert!(dest <= from && from <= to && to <= v.len());
+    for k in 0..to.saturating_sub(from) {
+        if let Some(&x) = v.get(from + k) {
+            if let Some(slot) = v.get_mut(dest + k) {
+                *slot = x;
+            }
+        }
+    }
+}
+
 struct Builder<'p, P> {
     prims: &'p [P],
 }
@@ -296,7 +310,9 @@ impl<P> Builder<'_, P> {
         let bin = |x: f32, a: usize| -> usize {
             let a = a.min(2);
             // Saturating cast (NaN -> 0), then clamped: always a valid bin.
-            (((x - lo_f[a]) * scale[a]) as i64).clamp(0, nb as i64 - 1) as usize
+            (((x - lo_f[a]) * scale[a]) as i64)
+                .min(nb as i64 - 1)
+                .max(0) as usize
         };
         // Per axis: primitives whose clipped box starts / ends in each bin.
         let mut starts = [[0u32; BINS]; 3];
