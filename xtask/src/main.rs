@@ -96,7 +96,8 @@ fn run(mut c: Command) -> (bool, String) {
 
 /// defmt-test's progress: the highest `(i/N)` seen, N, and whether it finished.
 fn progress(output: &str) -> (usize, usize, bool) {
-    let (mut last, mut total) = (0, 0);
+    // Several test binaries run one after the other; each restarts at (1/N).
+    let (mut base, mut last, mut total, mut binaries) = (0, 0, 0, 0);
     for line in output.lines() {
         let Some(rest) = line.trim().strip_prefix('(') else {
             continue;
@@ -108,11 +109,16 @@ fn progress(output: &str) -> (usize, usize, bool) {
             continue;
         };
         if let (Ok(i), Ok(n), true) = (i.parse(), n.parse(), rest.contains("running")) {
+            if i == 1 {
+                base += total;
+                binaries += 1;
+            }
             last = i;
             total = n;
         }
     }
-    (last, total, output.contains("all tests passed!"))
+    let finished = binaries > 0 && output.matches("all tests passed!").count() == binaries;
+    (base + last, base + total, finished)
 }
 
 fn elf(target: &str, profile: &str, bin: &str) -> PathBuf {
@@ -495,5 +501,11 @@ mod tests {
         let out = "(1/2) running `a`...\n(2/2) running `b`...\nall tests passed!\n";
         assert_eq!(progress(out), (2, 2, true));
         assert_eq!(progress("(x/2) running"), (0, 0, false));
+        // Two test binaries: counts add up, and both must finish.
+        let two = "(1/2) running `a`...\n(2/2) running `b`...\nall tests passed!\n\
+                   (1/3) running `c`...\n(2/3) running `d`...\n";
+        assert_eq!(progress(two), (4, 5, false));
+        let done = format!("{two}(3/3) running `e`...\nall tests passed!\n");
+        assert_eq!(progress(&done), (5, 5, true));
     }
 }
