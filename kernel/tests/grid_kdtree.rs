@@ -31,10 +31,10 @@ fn slab_axis_cases<S: TestScalar>() {
     for case in 0..20_000 {
         let o = [0, 1, 2].map(|_| (rng.range(-20.0, 20.0) * 4.0).round() / 4.0);
         let mut d = rng.unit_vec();
-        for k in 0..3 {
+        for x in &mut d {
             match rng.below(6) {
-                0 => d[k] = 0.0,
-                1 => d[k] = -0.0,
+                0 => *x = 0.0,
+                1 => *x = -0.0,
                 _ => {}
             }
         }
@@ -136,6 +136,9 @@ fn rays_at(points: &[[f32; 3]], seed: u64) -> Vec<RaySpec> {
     rays
 }
 
+/// A closest hit, or why the query was inconsistent (see `common::query`).
+type QueryResult<S> = Result<Option<raykernel::Hit<S>>, String>;
+
 /// Grid (three densities) and kd-tree (three depth limits) answer every ray like `Linear`.
 fn agree<S: TestScalar, P: Primitive<S> + std::fmt::Debug>(
     name: &str,
@@ -147,8 +150,7 @@ fn agree<S: TestScalar, P: Primitive<S> + std::fmt::Debug>(
         .iter()
         .map(|r| query(&linear, &r.ray::<S>()).unwrap())
         .collect();
-    let check = |accel: &dyn Fn(&Ray<S>) -> Result<Option<raykernel::Hit<S>>, String>,
-                 what: &str| {
+    let check = |accel: &dyn Fn(&Ray<S>) -> QueryResult<S>, what: &str| {
         for (r, w) in rays.iter().zip(&want) {
             let got = accel(&r.ray::<S>()).unwrap_or_else(|e| panic!("{name} {what}: {e}"));
             same_hit(&got, w).unwrap_or_else(|e| panic!("{} {name} {what}: {e}, ray {r}", S::NAME));

@@ -352,22 +352,21 @@ fn check_differential<S: TestScalar, P: Primitive<S> + std::fmt::Debug>(
         })?;
     }
     // The uniform grid and the kd-tree: the same answers, bit for bit.
-    let compare =
-        |name: &str, accel: &dyn Fn(&RaySpec) -> Result<Option<raykernel::Hit<S>>, String>| {
-            for (r, want) in rays.iter().zip(&want) {
-                let ctx = |msg: String| format!("{} {name}: {msg}; seed {}", S::NAME, seed());
-                let got = accel(r).map_err(|e| ctx(format!("{e}, ray {r}")))?;
-                same_hit(&got, want).map_err(|e| {
-                    let prim = |h: &Option<raykernel::Hit<S>>| h.map(|h| &prims[h.prim as usize]);
-                    ctx(format!(
-                        "{name} vs Linear: {e}, ray {r}; its prim {:?}, Linear's prim {:?}",
-                        prim(&got),
-                        prim(want)
-                    ))
-                })?;
-            }
-            Ok::<(), String>(())
-        };
+    let compare = |name: &str, accel: &dyn Fn(&RaySpec) -> QueryResult<S>| {
+        for (r, want) in rays.iter().zip(&want) {
+            let ctx = |msg: String| format!("{} {name}: {msg}; seed {}", S::NAME, seed());
+            let got = accel(r).map_err(|e| ctx(format!("{e}, ray {r}")))?;
+            same_hit(&got, want).map_err(|e| {
+                let prim = |h: &Option<raykernel::Hit<S>>| h.map(|h| &prims[h.prim as usize]);
+                ctx(format!(
+                    "{name} vs Linear: {e}, ray {r}; its prim {:?}, Linear's prim {:?}",
+                    prim(&got),
+                    prim(want)
+                ))
+            })?;
+        }
+        Ok::<(), String>(())
+    };
     for density in GRID_DENSITIES {
         let options = GridOptions { density };
         with_grid::<S, P, _>(prims, options, |grid| {
@@ -382,6 +381,9 @@ fn check_differential<S: TestScalar, P: Primitive<S> + std::fmt::Debug>(
     }
     Ok(())
 }
+
+/// A closest hit, or why the query was inconsistent (see `common::query`).
+type QueryResult<S> = Result<Option<raykernel::Hit<S>>, String>;
 
 fn triangles<S: TestScalar>(tris: &[[[f32; 3]; 3]]) -> Vec<Triangle<S>> {
     tris.iter()

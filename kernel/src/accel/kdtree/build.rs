@@ -329,8 +329,8 @@ impl<P> Builder<'_, P> {
         }
         let mut best: Option<(f32, usize, S)> = None;
         for a in 0..3 {
-            if !(ext[a] > 0.0) {
-                continue;
+            if scale[a] == 0.0 {
+                continue; // no extent (or NaN) on this axis
             }
             let (mut n_below, mut ended) = (0u32, 0u32);
             for b in 0..nb - 1 {

@@ -41,10 +41,7 @@ impl<S: Scalar, P: Primitive<S>> KdTree<'_, S, P> {
         }; MAX_DEPTH as usize];
         let mut sp = 0usize;
         let mut index = 0usize;
-        'walk: loop {
-            let Some(node) = self.nodes.get(index) else {
-                break;
-            };
+        'walk: while let Some(node) = self.nodes.get(index) {
             if node.is_leaf() {
                 let first = node.first() as usize;
                 let ids = self
