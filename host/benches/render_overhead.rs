@@ -11,7 +11,8 @@ use raykernel::bvh::{nodes_needed, BuildOptions};
 use raykernel::geom::spawn::{spawn_shadow_ray, SpawnScalar};
 use raykernel::glam::Vec3;
 use raykernel::render::{
-    encode_srgb8, AccelChoice, Camera, Light, Material, Object, Renderer, Scene, Settings, Shape,
+    encode_srgb8, AccelChoice, AccelMemory, Camera, Light, Material, Object, Renderer, Scene,
+    Settings, Shape,
 };
 use raykernel::{Accel, Bvh, Node, Ray, Triangle, I16F16};
 use std::hint::black_box;
@@ -125,14 +126,12 @@ fn bench_mode<S: SpawnScalar>(c: &mut Criterion) {
     };
     let mut nodes2 = vec![Node::EMPTY; nodes_needed(tris.len())];
     let mut ids2 = vec![0u32; tris.len()];
-    let r = Renderer::new(
-        &scene,
-        settings,
-        AccelChoice::default(),
-        &mut nodes2,
-        &mut ids2,
-    )
-    .unwrap();
+    let memory = AccelMemory {
+        bvh_nodes: &mut nodes2,
+        kd_nodes: &mut [],
+        words: &mut ids2,
+    };
+    let r = Renderer::new(&scene, settings, AccelChoice::default(), memory).unwrap();
     assert!(r.plan().pixel_centre && !r.plan().reflections && !r.plan().lens && !r.plan().motion);
     group.bench_function("renderer_bare_plan", |b| {
         b.iter(|| r.render_srgb8(black_box(&mut out)).unwrap());

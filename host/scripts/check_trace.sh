@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Checks `host trace` on the shared scenes: every BVH builder against brute force, byte for byte.
+# Checks `host trace` on the shared scenes: every BVH builder, the uniform grid and the kd-tree
+# against brute force, byte for byte.
 #
 # usage: host/scripts/check_trace.sh RAYS_DIR
 #
@@ -7,10 +8,10 @@
 #   python3 ../shared/bench/make_rays.py --out RAYS_DIR bunny sponza kitchen
 #
 # For each scene, ray set and mode (f32, fixed):
-#   - traces the whole file with each builder (sah, median, midpoint) and checks the three
-#     hit files are identical;
-#   - traces every STRIDE-th ray with --accel linear and with each builder, and checks each
-#     strided BVH hit file equals the linear one (cmp);
+#   - traces the whole file with each builder (sah, median, midpoint), the grid and the kd-tree,
+#     and checks the five hit files are identical;
+#   - traces every STRIDE-th ray with --accel linear, each builder, the grid and the kd-tree,
+#     and checks each strided hit file equals the linear one (cmp);
 # then prints the fixed-vs-f32 agreement of the SAH primary hits per scene (compare-hits --scene
 # --rays), which classifies every ray whose prim differs; any "unexplained" one (farther than the
 # quantization bound from every edge of both triangles, and not a depth tie) is a failure.
@@ -34,6 +35,7 @@ scenes=${SCENES:-bunny sponza kitchen}
 kinds=${KINDS:-primary incoherent}
 scenes_dir=${SCENES_DIR:-$root/../shared/scenes}
 builders="sah median midpoint"
+accels="grid kdtree"
 modes="f32 fixed"
 
 if [ -z "${HOST_BIN:-}" ]; then
@@ -85,7 +87,10 @@ for scene in $scenes; do
             for b in $builders; do
                 trace "$tag $b" "$out/$tag.$b.hits" "$obj" "$rays" --mode "$mode" --builder "$b"
             done
-            for b in median midpoint; do
+            for a in $accels; do
+                trace "$tag $a" "$out/$tag.$a.hits" "$obj" "$rays" --mode "$mode" --accel "$a"
+            done
+            for b in median midpoint $accels; do
                 same "$tag $b == sah (full)" "$out/$tag.$b.hits" "$out/$tag.sah.hits"
             done
             trace "$tag linear /$stride" "$out/$tag.linear.s$stride.hits" "$obj" "$rays" \
@@ -96,8 +101,15 @@ for scene in $scenes; do
                 same "$tag $b == linear (/$stride)" "$out/$tag.$b.s$stride.hits" \
                     "$out/$tag.linear.s$stride.hits"
             done
+            for a in $accels; do
+                trace "$tag $a /$stride" "$out/$tag.$a.s$stride.hits" "$obj" "$rays" \
+                    --mode "$mode" --accel "$a" --stride "$stride"
+                same "$tag $a == linear (/$stride)" "$out/$tag.$a.s$stride.hits" \
+                    "$out/$tag.linear.s$stride.hits"
+            done
             # Keep only what the agreement report below needs.
-            rm -f "$out/$tag.median.hits" "$out/$tag.midpoint.hits" "$out/$tag".*.s"$stride".hits
+            rm -f "$out/$tag.median.hits" "$out/$tag.midpoint.hits" "$out/$tag".*.s"$stride".hits \
+                "$out/$tag.grid.hits" "$out/$tag.kdtree.hits"
         done
     done
 done
@@ -127,5 +139,5 @@ if [ "$failures" -gt 0 ]; then
     echo "check_trace: $failures comparison(s) DIFFERENT or UNEXPLAINED" >&2
     exit 1
 fi
-echo "check_trace: all BVH hit files match brute force (stride $stride) and each other;" \
+echo "check_trace: all BVH, grid and kd-tree hit files match brute force (stride $stride) and each other;" \
     "fixed vs f32 differences are all within quantization"

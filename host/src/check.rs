@@ -3,7 +3,8 @@
 //! For each scene and mode, the reference is the kernel's single-threaded whole-image path
 //! ([`raykernel::render::Renderer::render_srgb8`], default BVH). Compared with it, byte for byte:
 //! the host's parallel tiles at 1, 2 and 3 threads and with an odd tile size, and every
-//! accelerator the host knows (brute force; the BVH with each builder at leaf sizes 1 and 4).
+//! accelerator the host knows (brute force; the BVH with each builder at leaf sizes 1 and 4;
+//! the uniform grid; the kd-tree).
 
 use crate::error::Error;
 use crate::render::{
@@ -69,7 +70,7 @@ pub fn first_difference(expected: &Image, actual: &Image) -> Option<PixelDiff> {
 }
 
 /// One way of rendering that must match the reference.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Variant {
     /// Threads.
     pub threads: usize,
@@ -118,7 +119,9 @@ pub fn variants() -> Vec<Variant> {
                     })
                 })
                 .collect(),
-            AccelKind::Linear => vec![BuildOptions::default()],
+            AccelKind::Linear | AccelKind::Grid | AccelKind::Kdtree => {
+                vec![BuildOptions::default()]
+            }
         };
         for build in builds {
             v.push(Variant {

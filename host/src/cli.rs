@@ -327,7 +327,7 @@ pub struct TraceReport {
     pub rays_file: String,
     /// Hit file path.
     pub out: String,
-    /// `bvh` or `linear`.
+    /// `bvh`, `linear`, `grid` or `kdtree`.
     pub accel: &'static str,
     /// `sah`, `median` or `midpoint`; `null` for linear.
     pub builder: Option<&'static str>,
@@ -560,7 +560,8 @@ pub fn run_check(args: &CheckArgs) -> Result<CheckReport, Error> {
 pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
     if args.leaf_order && args.accel != AccelKind::Bvh {
         return Err(Error::Usage(
-            "--leaf-order needs --accel bvh (brute force has no leaves)".into(),
+            "--leaf-order needs --accel bvh (the other accelerators do not permute primitives)"
+                .into(),
         ));
     }
     let mesh = load_obj(&args.scene)?;

@@ -12,36 +12,42 @@ use raykernel::bvh::BuildOptions;
 use raykernel::geom::spawn::SpawnScalar;
 use raykernel::render::scenes::SceneData;
 use raykernel::render::{
-    encode_srgb8, memory_needed, AccelChoice, Object, RenderPlan, RenderStats, Renderer, Rgb,
-    SceneError, Settings, Shape, Tile,
+    encode_srgb8, memory_needed, AccelChoice, AccelMemory, Object, RenderPlan, RenderStats,
+    Renderer, Rgb, SceneError, Settings, Shape, Tile,
 };
-use raykernel::{Node, Scalar, Sphere, Triangle, I16F16};
+use raykernel::{GridOptions, KdNode, KdOptions, Node, Scalar, Sphere, Triangle, I16F16};
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
-/// The kernel's accelerator for an [`AccelKind`] chosen on the command line. New kinds (a grid,
-/// a kd-tree) get their arm here once the kernel's [`AccelChoice`] has them.
+/// The kernel's accelerator for an [`AccelKind`] chosen on the command line (`build` applies to
+/// the BVH; the grid and the kd-tree use their defaults).
 #[must_use]
 pub fn accel_choice(kind: AccelKind, build: BuildOptions) -> AccelChoice {
     match kind {
         AccelKind::Bvh => AccelChoice::Bvh(build),
         AccelKind::Linear => AccelChoice::Linear,
+        AccelKind::Grid => AccelChoice::Grid(GridOptions::default()),
+        AccelKind::Kdtree => AccelChoice::KdTree(KdOptions::default()),
     }
 }
 
-/// A short name of an accelerator choice: `linear`, or `bvh sah leaf 4`.
+/// A short name of an accelerator choice: `linear`, `bvh sah leaf 4`, `grid density 2`,
+/// `kdtree depth auto`.
 #[must_use]
 pub fn accel_name(a: AccelChoice) -> String {
     match a {
         AccelChoice::Linear => "linear".into(),
         AccelChoice::Bvh(o) => format!("bvh {} leaf {}", o.builder.name(), o.max_leaf_size),
+        AccelChoice::Grid(o) => format!("grid density {}", o.density),
+        AccelChoice::KdTree(o) if o.max_depth == 0 => "kdtree depth auto".into(),
+        AccelChoice::KdTree(o) => format!("kdtree depth {}", o.max_depth),
     }
 }
 
 /// How to render (the scene and its settings come separately).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderOptions {
     /// Number mode of the geometry.
     pub mode: Mode,
@@ -150,13 +156,16 @@ pub fn with_renderer<S: SpawnScalar, R>(
     data.spheres_into(&mut spheres)?;
     let mut objects = vec![Object::new(Shape::Triangles(&[]), 0); data.objects.len()];
     let scene = data.scene(&triangles, &spheres, &mut objects)?;
-    let (node_count, id_count) = match accel {
-        AccelChoice::Bvh(_) => memory_needed(scene.objects),
-        AccelChoice::Linear => (0, 0),
+    let need = memory_needed(scene.objects, accel);
+    let mut bvh_nodes = vec![Node::<S>::EMPTY; need.bvh_nodes];
+    let mut kd_nodes = vec![KdNode::<S>::EMPTY; need.kd_nodes];
+    let mut words = vec![0u32; need.words];
+    let memory = AccelMemory {
+        bvh_nodes: &mut bvh_nodes,
+        kd_nodes: &mut kd_nodes,
+        words: &mut words,
     };
-    let mut nodes = vec![Node::<S>::EMPTY; node_count];
-    let mut ids = vec![0u32; id_count];
-    let renderer = Renderer::new(&scene, settings, accel, &mut nodes, &mut ids)?;
+    let renderer = Renderer::new(&scene, settings, accel, memory)?;
     let build_ms = start.elapsed().as_secs_f64() * 1e3;
     Ok((f(&renderer), build_ms))
 }

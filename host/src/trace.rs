@@ -5,7 +5,10 @@ use crate::error::Error;
 use crate::obj::Mesh;
 use crate::rayfile::{HitRecord, RayRecord};
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
-use raykernel::{Accel, Bvh, Linear, Node, Ray, Scalar, Triangle, I16F16};
+use raykernel::{
+    kdtree, Accel, Bvh, Grid, GridOptions, KdNode, KdOptions, KdTree, Linear, Node, Ray, Scalar,
+    Triangle, I16F16,
+};
 use std::path::Path;
 use std::time::Instant;
 
@@ -16,6 +19,10 @@ pub enum AccelKind {
     Bvh,
     /// Brute force over every triangle: the reference.
     Linear,
+    /// The kernel's uniform grid (default density).
+    Grid,
+    /// The kernel's kd-tree (SAH, automatic depth).
+    Kdtree,
 }
 
 impl AccelKind {
@@ -25,6 +32,8 @@ impl AccelKind {
         match self {
             Self::Bvh => "bvh",
             Self::Linear => "linear",
+            Self::Grid => "grid",
+            Self::Kdtree => "kdtree",
         }
     }
 }
@@ -110,11 +119,11 @@ pub struct TraceStats {
     pub hits: usize,
     /// Rays the kernel rejected (written as misses).
     pub bad_rays: usize,
-    /// BVH nodes in use (0 for linear).
+    /// BVH or kd-tree nodes in use, grid cells (0 for linear).
     pub nodes: usize,
-    /// Bytes of nodes and primitive ids in use (0 for linear).
+    /// Bytes of nodes (cell offsets) and primitive ids (references) in use (0 for linear).
     pub accel_bytes: usize,
-    /// Depth of the deepest leaf (0 for linear).
+    /// Depth of the deepest leaf (0 for linear and the grid).
     pub depth: u32,
 }
 
@@ -160,14 +169,33 @@ fn trace_in<S: Scalar>(
     let tris = mesh.kernel_triangles::<S>(scene)?;
     let mut arena = match config.accel {
         AccelKind::Bvh => NodeArena::<S>::new(nodes_needed(tris.len())),
-        AccelKind::Linear => NodeArena::<S>::new(0),
+        _ => NodeArena::<S>::new(0),
     };
+    // Grid and kd-tree memory, allocated once (untimed, like the BVH's arena); the grid's
+    // counting pass is repeated, timed, in every run, as a caller sizing memory would do.
+    let mut other = OtherArenas::<S>::default();
+    match config.accel {
+        AccelKind::Grid => {
+            let size =
+                Grid::size_for(&tris, GridOptions::default()).map_err(|source| Error::Build {
+                    scene: scene.to_path_buf(),
+                    source,
+                })?;
+            other.cells = vec![0; size.cells];
+            other.refs = vec![0; size.refs];
+        }
+        AccelKind::Kdtree => {
+            other.kd_nodes = vec![KdNode::EMPTY; kdtree::nodes_needed(tris.len())];
+            other.refs = vec![0; kdtree::refs_needed(tris.len())];
+        }
+        _ => {}
+    }
     let mut first: Option<Vec<HitRecord>> = None;
     let mut last = None;
     let (mut build_ms_runs, mut trace_ms_runs) = (Vec::new(), Vec::new());
     let mut setup_ms_runs = Vec::new();
     for run in 0..config.runs {
-        let (hits, stats) = run_once(&tris, &mut arena, scene, rays, config)?;
+        let (hits, stats) = run_once(&tris, &mut arena, &mut other, scene, rays, config)?;
         if let Some(first) = &first {
             if let Some(ray) = first_difference(first, &hits) {
                 return Err(Error::RunsDiffer {
@@ -201,6 +229,7 @@ fn trace_in<S: Scalar>(
 fn run_once<S: Scalar>(
     tris: &[Triangle<S>],
     arena: &mut NodeArena<S>,
+    other: &mut OtherArenas<S>,
     scene: &Path,
     rays: &[RayRecord],
     config: &TraceConfig,
@@ -211,6 +240,43 @@ fn run_once<S: Scalar>(
     };
     match config.accel {
         AccelKind::Linear => Ok(trace_rays(&Linear::new(tris), rays, config.stride)),
+        AccelKind::Grid => {
+            let options = GridOptions::default();
+            let start = Instant::now();
+            let size = Grid::size_for(tris, options).map_err(build_error)?;
+            let grid = Grid::build(tris, &mut other.cells, &mut other.refs, options)
+                .map_err(build_error)?;
+            let build_ms = millis(start);
+            debug_assert_eq!(grid.refs().len(), size.refs);
+            let (hits, stats) = trace_rays(&grid, rays, config.stride);
+            let stats = TraceStats {
+                build_ms,
+                nodes: grid.cells().len().saturating_sub(1),
+                accel_bytes: grid.bytes_used(),
+                ..stats
+            };
+            Ok((hits, stats))
+        }
+        AccelKind::Kdtree => {
+            let start = Instant::now();
+            let tree = KdTree::build(
+                tris,
+                &mut other.kd_nodes,
+                &mut other.refs,
+                KdOptions::default(),
+            )
+            .map_err(build_error)?;
+            let build_ms = millis(start);
+            let (hits, stats) = trace_rays(&tree, rays, config.stride);
+            let stats = TraceStats {
+                build_ms,
+                nodes: tree.nodes().len(),
+                accel_bytes: tree.bytes_used(),
+                depth: tree.depth(),
+                ..stats
+            };
+            Ok((hits, stats))
+        }
         AccelKind::Bvh if config.leaf_order => {
             // The permutation works in place: give it a fresh copy (untimed, like parsing).
             let mut own = tris.to_vec();
@@ -268,6 +334,23 @@ pub fn median(xs: &[f64]) -> f64 {
         0 => 0.0,
         _ if n % 2 == 1 => v[n / 2],
         _ => (v[n / 2 - 1] + v[n / 2]) / 2.0,
+    }
+}
+
+/// Memory of the grid (cell offsets, references) and the kd-tree (nodes, references).
+struct OtherArenas<S: Scalar> {
+    cells: Vec<u32>,
+    refs: Vec<u32>,
+    kd_nodes: Vec<KdNode<S>>,
+}
+
+impl<S: Scalar> Default for OtherArenas<S> {
+    fn default() -> Self {
+        Self {
+            cells: Vec::new(),
+            refs: Vec::new(),
+            kd_nodes: Vec::new(),
+        }
     }
 }
 

@@ -182,7 +182,7 @@ fn bad_arguments_are_usage_errors() {
             vec!["--mode", "double"],
             "invalid value 'double' for '--mode",
         ),
-        (vec!["--accel", "grid"], "invalid value 'grid'"),
+        (vec!["--accel", "octree"], "invalid value 'octree'"),
         (vec!["--builder", "lbvh"], "invalid value 'lbvh'"),
         (vec!["--leaf", "0"], "--leaf"),
         (vec!["--leaf", "65"], "--leaf"),

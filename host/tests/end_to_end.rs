@@ -161,6 +161,24 @@ fn every_bvh_configuration_matches_brute_force_byte_for_byte() {
 }
 
 #[test]
+fn grid_and_kdtree_match_brute_force_byte_for_byte() {
+    let s = scene("end_to_end_grid_kdtree");
+    for mode in [Mode::F32, Mode::Fixed] {
+        let (_, reference) = run(&args(&s, AccelKind::Linear, Builder::Sah, mode, 4));
+        for accel in [AccelKind::Grid, AccelKind::Kdtree] {
+            let a = args(&s, accel, Builder::Sah, mode, 4);
+            let (report, bytes) = run(&a);
+            assert!(
+                bytes == reference,
+                "{mode:?} {accel:?}: hit file differs from linear"
+            );
+            assert_eq!(report.accel, accel.name());
+            assert!(report.nodes > 0 && report.bytes_per_tri > 0.0, "{report:?}");
+        }
+    }
+}
+
+#[test]
 fn modes_agree_on_which_rays_hit_the_sphere() {
     let s = scene("end_to_end_modes");
     let trace = |mode| {

@@ -1,5 +1,6 @@
 //! The shared benchmark scenes (`../shared/scenes`, beside the workspace), when present:
-//! every BVH builder must give the same hits as brute force, byte for byte, in both modes.
+//! every BVH builder, the grid and the kd-tree must give the same hits as brute force, byte for
+//! byte, in both modes.
 
 mod common;
 
@@ -66,6 +67,13 @@ fn bunny_bvh_matches_brute_force_for_every_builder_and_mode() {
             assert!(
                 encode_hits(&bvh.hits) == reference,
                 "{mode:?} {builder:?}: differs from linear, first (ray, bvh, linear): {differ:?}"
+            );
+        }
+        for accel in [AccelKind::Grid, AccelKind::Kdtree] {
+            let other = trace(&mesh, &obj, &rays, &config(accel, BuilderKind::Sah)).unwrap();
+            assert!(
+                encode_hits(&other.hits) == reference,
+                "{mode:?} {accel:?}: differs from linear"
             );
         }
     }

@@ -71,6 +71,10 @@ pub enum Arena {
     Nodes,
     /// The primitive-id slice.
     PrimIds,
+    /// The uniform grid's cell slice (one offset per cell, plus one).
+    Cells,
+    /// The uniform grid's or kd-tree's primitive-reference slice.
+    Refs,
 }
 
 /// Why an acceleration structure could not be built.
@@ -105,6 +109,23 @@ pub enum BuildError {
         /// The value given.
         max_leaf_size: u32,
     },
+    /// The uniform grid would hold more primitive references than a 32-bit offset can
+    /// address (`needed` is the exact count): lower the density or split the scene.
+    TooManyRefs {
+        /// References the grid would need.
+        needed: u64,
+    },
+    /// The grid density (cells per primitive) is not a finite number in
+    /// `(0, `[`crate::grid::MAX_DENSITY`]`]`.
+    BadDensity {
+        /// The value given.
+        density: f32,
+    },
+    /// The kd-tree depth limit is above [`crate::kdtree::MAX_DEPTH`].
+    BadMaxDepth {
+        /// The value given.
+        max_depth: u32,
+    },
 }
 
 impl fmt::Display for BuildError {
@@ -135,6 +156,26 @@ impl fmt::Display for BuildError {
                     f,
                     "max_leaf_size {max_leaf_size} is outside 1..={}",
                     crate::bvh::MAX_LEAF_SIZE
+                )
+            }
+            Self::TooManyRefs { needed } => {
+                write!(
+                    f,
+                    "{needed} primitive references exceed the 32-bit offset space"
+                )
+            }
+            Self::BadDensity { density } => {
+                write!(
+                    f,
+                    "grid density {density} is outside (0, {}]",
+                    crate::grid::MAX_DENSITY
+                )
+            }
+            Self::BadMaxDepth { max_depth } => {
+                write!(
+                    f,
+                    "kd-tree max_depth {max_depth} is above {}",
+                    crate::kdtree::MAX_DEPTH
                 )
             }
         }

@@ -6,7 +6,8 @@
 //! - Two number modes with one set of algorithms: `f32` (API in `glam::Vec3`) and the
 //!   fixed-point [`I16F16`] (Q16.16 coordinates, Q2.30 unit directions, exact integer tests).
 //! - A BVH built into caller memory by one of three builders (binned SAH, median, midpoint),
-//!   traversed with a fixed stack sized from the depth cap, near child first.
+//!   traversed with a fixed stack sized from the depth cap, near child first; a uniform grid
+//!   ([`Grid`], rounding-proof 3D-DDA) and a kd-tree ([`KdTree`], SAH) with the same query API.
 //! - Watertight ray/triangle tests (Woop, Benthin, Wald 2013 in `f32`; exact integer edge
 //!   functions in fixed point) and a conservative slab test (Ize 2013), so rays through shared
 //!   edges and vertices never slip through and traversal never culls a box it should enter.
@@ -39,6 +40,8 @@ pub mod render;
 pub mod scalar;
 
 pub use accel::bvh::{self, Bvh, Node};
+pub use accel::grid::{self, Grid, GridOptions};
+pub use accel::kdtree::{self, KdNode, KdOptions, KdTree};
 pub use accel::{Accel, Counters, Linear, NoStats, TraversalStats};
 pub use error::{Arena, BuildError, PointError, RayError};
 pub use geom::{spawn, Aabb, Hit, Primitive, Ray, Sphere, Triangle};

@@ -2,6 +2,9 @@
 //! and leaf sizes 1, 2, 4 and 8:
 //! - the tree passes `validate()` after every build (and respects the leaf size);
 //! - the BVH's closest hit equals brute force (`Linear`) bit for bit: t, primitive, u and v;
+//! - so do the uniform grid's (densities 0.25, 2 and 8, each built into arenas of exactly the
+//!   counted size and validated) and the kd-tree's (automatic depth, depth 3 and the maximum,
+//!   built into the documented budgets and validated);
 //! - any-hit (`occluded`) is true exactly when there is a closest hit.
 //!
 //! Scenes are triangle soups with random, small, degenerate, duplicated (coincident, permuted)
@@ -13,11 +16,14 @@
 
 mod common;
 
-use common::{all_options, dir_to, query, same_hit, with_bvh, RaySpec, TestScalar};
+use common::{
+    all_options, dir_to, query, same_hit, with_bvh, with_grid, with_kdtree, RaySpec, TestScalar,
+    GRID_DENSITIES, KD_DEPTHS,
+};
 use proptest::prelude::*;
 use proptest::test_runner::{Config as ProptestConfig, RngSeed};
 use raykernel::bvh::BuildOptions;
-use raykernel::{Accel, Linear, Primitive, Sphere, Triangle, I16F16};
+use raykernel::{Accel, GridOptions, KdOptions, Linear, Primitive, Sphere, Triangle, I16F16};
 
 const SEED: u64 = 0x5eed_7a11_0001;
 /// Cases per property (each case: 2 modes × 3 builders × 4 leaf sizes × RAYS_PER_CASE rays).
@@ -345,8 +351,39 @@ fn check_differential<S: TestScalar, P: Primitive<S> + std::fmt::Debug>(
             Ok(())
         })?;
     }
+    // The uniform grid and the kd-tree: the same answers, bit for bit.
+    let compare = |name: &str, accel: &dyn Fn(&RaySpec) -> QueryResult<S>| {
+        for (r, want) in rays.iter().zip(&want) {
+            let ctx = |msg: String| format!("{} {name}: {msg}; seed {}", S::NAME, seed());
+            let got = accel(r).map_err(|e| ctx(format!("{e}, ray {r}")))?;
+            same_hit(&got, want).map_err(|e| {
+                let prim = |h: &Option<raykernel::Hit<S>>| h.map(|h| &prims[h.prim as usize]);
+                ctx(format!(
+                    "{name} vs Linear: {e}, ray {r}; its prim {:?}, Linear's prim {:?}",
+                    prim(&got),
+                    prim(want)
+                ))
+            })?;
+        }
+        Ok::<(), String>(())
+    };
+    for density in GRID_DENSITIES {
+        let options = GridOptions { density };
+        with_grid::<S, P, _>(prims, options, |grid| {
+            compare(&format!("{options:?}"), &|r| query(grid, &r.ray::<S>()))
+        })?;
+    }
+    for max_depth in KD_DEPTHS {
+        let options = KdOptions { max_depth };
+        with_kdtree::<S, P, _>(prims, options, |tree| {
+            compare(&format!("{options:?}"), &|r| query(tree, &r.ray::<S>()))
+        })?;
+    }
     Ok(())
 }
+
+/// A closest hit, or why the query was inconsistent (see `common::query`).
+type QueryResult<S> = Result<Option<raykernel::Hit<S>>, String>;
 
 fn triangles<S: TestScalar>(tris: &[[[f32; 3]; 3]]) -> Vec<Triangle<S>> {
     tris.iter()

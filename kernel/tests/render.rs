@@ -10,10 +10,11 @@ use raykernel::render::sampling::{
 };
 use raykernel::render::scenes::{self, SceneData};
 use raykernel::render::{
-    memory_needed, AccelChoice, Camera, Filter, Item, Light, Material, Object, Problem, Renderer,
-    SamplerKind, Scene, SceneError, Settings, Shape, Tile, MAX_LIGHTS, MAX_OBJECTS,
+    memory_needed, AccelChoice, AccelMemory, Camera, Filter, Item, Light, Material, MemoryNeeded,
+    Object, Problem, Renderer, SamplerKind, Scene, SceneError, Settings, Shape, Tile, MAX_LIGHTS,
+    MAX_OBJECTS,
 };
-use raykernel::{Node, Sphere, Triangle, I16F16};
+use raykernel::{GridOptions, KdNode, KdOptions, Node, Sphere, Triangle, I16F16};
 use std::f64::consts::PI;
 
 /// Renders `scene` into linear RGB with a BVH (or brute force).
@@ -22,8 +23,8 @@ fn render<S: SpawnScalar>(
     settings: Settings,
     accel: AccelChoice,
 ) -> Result<Vec<[f32; 3]>, SceneError> {
-    let (mut nodes, mut ids) = buffers(scene);
-    let r = Renderer::new(scene, settings, accel, &mut nodes, &mut ids)?;
+    let mut memory = Memory::new(scene, accel);
+    let r = Renderer::new(scene, settings, accel, memory.lend())?;
     let mut out = vec![[0.0f32; 3]; (settings.width * settings.height) as usize];
     let tile = Tile {
         x: 0,
@@ -61,10 +62,31 @@ fn cube(half: f32, x_offset: f32) -> Vec<[[f32; 3]; 3]> {
     out
 }
 
-/// Node and id buffers of the size [`memory_needed`] gives.
-fn buffers<S: SpawnScalar>(scene: &Scene<'_, S>) -> (Vec<Node<S>>, Vec<u32>) {
-    let (n, i) = memory_needed(scene.objects);
-    (vec![Node::EMPTY; n], vec![0u32; i])
+/// Accelerator buffers of the sizes [`memory_needed`] gives.
+struct Memory<S: SpawnScalar> {
+    bvh_nodes: Vec<Node<S>>,
+    kd_nodes: Vec<KdNode<S>>,
+    words: Vec<u32>,
+}
+
+impl<S: SpawnScalar> Memory<S> {
+    fn new(scene: &Scene<'_, S>, accel: AccelChoice) -> Self {
+        Self::sized(memory_needed(scene.objects, accel))
+    }
+    fn sized(n: MemoryNeeded) -> Self {
+        Self {
+            bvh_nodes: vec![Node::EMPTY; n.bvh_nodes],
+            kd_nodes: vec![KdNode::EMPTY; n.kd_nodes],
+            words: vec![0; n.words],
+        }
+    }
+    fn lend(&mut self) -> AccelMemory<'_, S> {
+        AccelMemory {
+            bvh_nodes: &mut self.bvh_nodes,
+            kd_nodes: &mut self.kd_nodes,
+            words: &mut self.words,
+        }
+    }
 }
 
 fn tris<S: SpawnScalar>(t: &[[[f32; 3]; 3]]) -> Vec<Triangle<S>> {
@@ -468,8 +490,8 @@ fn tiles_equal_whole<S: SpawnScalar>(d: &SceneData<'_>) {
     with_scene::<S, _>(d, |scene| {
         let st = d.settings;
         let whole = render(scene, st, AccelChoice::default()).unwrap();
-        let (mut nodes, mut ids) = buffers(scene);
-        let r = Renderer::new(scene, st, AccelChoice::default(), &mut nodes, &mut ids).unwrap();
+        let mut memory = Memory::new(scene, AccelChoice::default());
+        let r = Renderer::new(scene, st, AccelChoice::default(), memory.lend()).unwrap();
         // Odd tiles, rendered bottom-right first.
         let mut tiled = vec![[0.0f32; 3]; whole.len()];
         let (tw, th) = (7u32, 5u32);
@@ -494,9 +516,21 @@ fn tiles_equal_whole<S: SpawnScalar>(d: &SceneData<'_>) {
         }
         let bits = |v: &[[f32; 3]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&whole), bits(&tiled), "{} {}", d.name, S::NAME);
-        // Brute force gives the same bits.
-        let linear = render(scene, st, AccelChoice::Linear).unwrap();
-        assert_eq!(bits(&whole), bits(&linear), "{} {} linear", d.name, S::NAME);
+        // Brute force, the grid and the kd-tree give the same bits.
+        for accel in [
+            AccelChoice::Linear,
+            AccelChoice::Grid(GridOptions::default()),
+            AccelChoice::KdTree(KdOptions::default()),
+        ] {
+            let other = render(scene, st, accel).unwrap();
+            assert_eq!(
+                bits(&whole),
+                bits(&other),
+                "{} {} {accel:?}",
+                d.name,
+                S::NAME
+            );
+        }
     });
 }
 
@@ -512,16 +546,10 @@ fn tiles_in_any_order_equal_the_whole_image() {
 fn plans_follow_the_scenes() {
     let plan = |d: &SceneData<'_>| {
         with_scene::<f32, _>(d, |scene| {
-            let (mut nodes, mut ids) = buffers(scene);
-            let plan = *Renderer::new(
-                scene,
-                d.settings,
-                AccelChoice::default(),
-                &mut nodes,
-                &mut ids,
-            )
-            .unwrap()
-            .plan();
+            let mut memory = Memory::new(scene, AccelChoice::default());
+            let plan = *Renderer::new(scene, d.settings, AccelChoice::default(), memory.lend())
+                .unwrap()
+                .plan();
             plan
         })
     };
@@ -772,8 +800,6 @@ fn buffers_and_tiles_are_checked_exactly() {
         camera: narrow_camera([0.0, 2.0, 1.0]),
         background: [0.0; 3],
     };
-    let (n, i) = memory_needed(scene.objects);
-    assert_eq!((n, i), (8, 4));
     let st = Settings {
         width: 4,
         height: 3,
@@ -784,32 +810,54 @@ fn buffers_and_tiles_are_checked_exactly() {
         builder: BuilderKind::Median,
         max_leaf_size: 1,
     });
-    let mut nodes = vec![Node::EMPTY; n - 1];
-    let mut ids = vec![0u32; i];
-    let err = Renderer::new(&scene, st, bvh, &mut nodes, &mut ids).unwrap_err();
-    assert_eq!(
-        err.problem,
-        Problem::TooSmall {
-            needed: 8,
-            available: 7
-        }
-    );
-    assert_eq!(err.field, "nodes");
-    let mut nodes = vec![Node::EMPTY; n];
-    let mut ids = vec![0u32; i - 1];
-    let err = Renderer::new(&scene, st, bvh, &mut nodes, &mut ids).unwrap_err();
-    assert_eq!(
-        (err.field, err.problem),
-        (
-            "prim_ids",
-            Problem::TooSmall {
-                needed: 4,
-                available: 3
+    let kd = AccelChoice::KdTree(KdOptions::default());
+    let grid = AccelChoice::Grid(GridOptions::default());
+    let bvh_need = memory_needed(scene.objects, bvh);
+    let kd_need = memory_needed(scene.objects, kd);
+    let grid_need = memory_needed(scene.objects, grid);
+    let need = |bvh_nodes, kd_nodes, words| MemoryNeeded {
+        bvh_nodes,
+        kd_nodes,
+        words,
+    };
+    // Two objects of two triangles: BVH 2·(2n) nodes and n ids, kd-tree 4n+1 nodes and 6n refs.
+    assert_eq!(bvh_need, need(8, 0, 4));
+    assert_eq!(kd_need, need(0, 18, 24));
+    assert_eq!((grid_need.bvh_nodes, grid_need.kd_nodes), (0, 0));
+    assert!(grid_need.words > 0);
+    // One element short in each buffer: a typed error naming it, with the exact sizes.
+    for (accel, n) in [(bvh, bvh_need), (kd, kd_need), (grid, grid_need)] {
+        let shorts = [
+            (
+                "bvh_nodes",
+                n.bvh_nodes,
+                need(n.bvh_nodes.wrapping_sub(1), n.kd_nodes, n.words),
+            ),
+            (
+                "kd_nodes",
+                n.kd_nodes,
+                need(n.bvh_nodes, n.kd_nodes.wrapping_sub(1), n.words),
+            ),
+            ("words", n.words, need(n.bvh_nodes, n.kd_nodes, n.words - 1)),
+        ];
+        for (field, needed, short) in shorts {
+            if needed == 0 {
+                continue;
             }
-        )
-    );
+            let mut memory = Memory::sized(short);
+            let err = Renderer::new(&scene, st, accel, memory.lend()).unwrap_err();
+            let available = needed - 1;
+            assert_eq!(
+                (err.field, err.problem),
+                (field, Problem::TooSmall { needed, available }),
+                "{accel:?}"
+            );
+        }
+        let mut memory = Memory::sized(n);
+        assert!(Renderer::new(&scene, st, accel, memory.lend()).is_ok());
+    }
     // Brute force needs no memory at all.
-    let r = Renderer::new(&scene, st, AccelChoice::Linear, &mut [], &mut []).unwrap();
+    let r = Renderer::new(&scene, st, AccelChoice::Linear, AccelMemory::default()).unwrap();
     let mut out = vec![0u8; 4 * 3 * 3];
     r.render_srgb8(&mut out).unwrap();
     let err = r.render_srgb8(&mut out[..35]).unwrap_err();

@@ -15,8 +15,8 @@ use common::{Rng, TestScalar};
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::spawn::{offset_origin, spawn_ray, spawn_shadow_ray, SpawnScalar};
 use raykernel::{
-    Aabb, Accel, Arena, BuildError, Bvh, Hit, Linear, Node, PointError, Primitive, Ray, RayError,
-    Scalar, Triangle, Vec3x, I16F16,
+    kdtree, Aabb, Accel, Arena, BuildError, Bvh, Grid, GridOptions, Hit, KdNode, KdOptions, KdTree,
+    Linear, Node, PointError, Primitive, Ray, RayError, Scalar, Triangle, Vec3x, I16F16,
 };
 use std::collections::{BTreeMap, HashMap};
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -491,12 +491,15 @@ fn interior(mesh: &Mesh, target: [f64; 3], rng: &mut Rng) -> [f64; 3] {
 // ---------------------------------------------------------------------------------------------
 // Accelerators and per-ray checks.
 
-/// The accelerators every ray goes through: SAH/4 (the answer), median/1, midpoint/8, and
-/// brute force on every `linear_stride`-th ray.
+/// The accelerators every ray goes through: SAH/4 (the answer), median/1, midpoint/8, the
+/// uniform grid and the kd-tree (default options), and brute force on every
+/// `linear_stride`-th ray.
 struct Accels<'a, S: Mode> {
     sah: Bvh<'a, S, Triangle<S>>,
     median: Bvh<'a, S, Triangle<S>>,
     midpoint: Bvh<'a, S, Triangle<S>>,
+    grid: Grid<'a, S, Triangle<S>>,
+    kdtree: KdTree<'a, S, Triangle<S>>,
     linear: Linear<'a, S, Triangle<S>>,
     linear_stride: usize,
 }
@@ -504,6 +507,10 @@ struct Accels<'a, S: Mode> {
 struct Arenas<S: Scalar> {
     nodes: [Vec<Node<S>>; 3],
     ids: [Vec<u32>; 3],
+    cells: Vec<u32>,
+    grid_refs: Vec<u32>,
+    kd_nodes: Vec<KdNode<S>>,
+    kd_refs: Vec<u32>,
 }
 
 impl<S: Mode> Arenas<S> {
@@ -511,6 +518,10 @@ impl<S: Mode> Arenas<S> {
         Self {
             nodes: [0; 3].map(|_| vec![Node::<S>::EMPTY; nodes_needed(n)]),
             ids: [0; 3].map(|_| vec![0u32; n]),
+            cells: Vec::new(),
+            grid_refs: Vec::new(),
+            kd_nodes: vec![KdNode::<S>::EMPTY; kdtree::nodes_needed(n)],
+            kd_refs: vec![0u32; kdtree::refs_needed(n)],
         }
     }
 }
@@ -518,6 +529,26 @@ impl<S: Mode> Arenas<S> {
 fn accels<'a, S: Mode>(tris: &'a [Triangle<S>], arenas: &'a mut Arenas<S>) -> Accels<'a, S> {
     let [n0, n1, n2] = &mut arenas.nodes;
     let [i0, i1, i2] = &mut arenas.ids;
+    let size =
+        Grid::size_for(tris, GridOptions::default()).unwrap_or_else(|e| panic!("grid size: {e}"));
+    arenas.cells.resize(size.cells, 0);
+    arenas.grid_refs.resize(size.refs, 0);
+    let grid = Grid::build(
+        tris,
+        &mut arenas.cells,
+        &mut arenas.grid_refs,
+        GridOptions::default(),
+    )
+    .unwrap_or_else(|e| panic!("grid build: {e}"));
+    grid.validate().unwrap_or_else(|e| panic!("grid: {e}"));
+    let kdtree = KdTree::build(
+        tris,
+        &mut arenas.kd_nodes,
+        &mut arenas.kd_refs,
+        KdOptions::default(),
+    )
+    .unwrap_or_else(|e| panic!("kd-tree build: {e}"));
+    kdtree.validate().unwrap_or_else(|e| panic!("kd-tree: {e}"));
     let opts = |builder, max_leaf_size| BuildOptions {
         builder,
         max_leaf_size,
@@ -531,6 +562,8 @@ fn accels<'a, S: Mode>(tris: &'a [Triangle<S>], arenas: &'a mut Arenas<S>) -> Ac
         sah: build(n0, i0, opts(BuilderKind::Sah, 4)),
         median: build(n1, i1, opts(BuilderKind::Median, 1)),
         midpoint: build(n2, i2, opts(BuilderKind::Midpoint, 8)),
+        grid,
+        kdtree,
         linear: Linear::new(tris),
         linear_stride: if tris.len() <= 2048 { 1 } else { 97 },
     }
@@ -560,6 +593,8 @@ fn trace<S: Mode>(a: &Accels<S>, ray: &Ray<S>, index: usize) -> (Option<Hit<S>>,
         a.midpoint.intersect(ray),
         a.midpoint.occluded(ray),
     );
+    check("grid", a.grid.intersect(ray), a.grid.occluded(ray));
+    check("kd-tree", a.kdtree.intersect(ray), a.kdtree.occluded(ray));
     if index % a.linear_stride == 0 {
         check("linear", a.linear.intersect(ray), a.linear.occluded(ray));
     }

@@ -12,7 +12,7 @@
 
 mod common;
 
-use common::{all_options, p, with_bvh, RaySpec, Rng, TestScalar};
+use common::{all_options, p, with_bvh, with_grid, with_kdtree, RaySpec, Rng, TestScalar};
 use raykernel::bvh::{BuildOptions, BuilderKind};
 use raykernel::{Accel, Linear, Ray, Triangle, I16F16};
 use std::collections::HashMap;
@@ -228,6 +228,15 @@ fn leak_report<S: TestScalar>(
         let accel = format!("bvh {}/{}", options.builder.name(), options.max_leaf_size);
         note(accel, rays.len(), leaks);
     }
+    // The uniform grid and the kd-tree, default options (built and validated by the helpers).
+    let leaks = with_grid::<S, _, _>(tris, raykernel::GridOptions::default(), |g| {
+        count_leaks(g, rays)
+    });
+    note("grid".into(), rays.len(), leaks);
+    let leaks = with_kdtree::<S, _, _>(tris, raykernel::KdOptions::default(), |k| {
+        count_leaks(k, rays)
+    });
+    note("kd-tree".into(), rays.len(), leaks);
     (total, lines)
 }
 

@@ -156,10 +156,10 @@ fn qemu() -> bool {
     for (target, core, machine, cpu) in TARGETS {
         println!("\n=== on-target tests: {core} ({target}, QEMU {machine}) ===");
         // The Cortex-M0's 16 KB of RAM cannot hold a render (about 20 KB of stack, measured on
-        // the M4F): it runs the kernel tests only.
+        // the M4F): it runs the kernel and accelerator tests only.
         let mut args = vec!["test", "--target", target];
         if target == "thumbv6m-none-eabi" {
-            args.extend(["--test", "kernel"]);
+            args.extend(["--test", "kernel", "--test", "accels"]);
         }
         let (ok, out) = run(cargo(&args));
         let (last, total, finished) = progress(&out);
@@ -267,31 +267,34 @@ fn readme_example_matches() -> bool {
     block.is_some() && block == example
 }
 
-/// Release-links `panic_never` for every target; returns (passed, failed).
+/// Release-links `panic_never` (BVH, brute force, rays, I16F16) and `panic_never_accels` (grid,
+/// kd-tree) for every target; returns (passed, failed), one count per binary and target.
 fn panic_check() -> (usize, usize) {
     let (mut passed, mut failed) = (0, 0);
-    for (target, core, _, _) in TARGETS {
-        let args = [
-            "build",
-            "--release",
-            "--bin",
-            "panic_never",
-            "--features",
-            "panic-check",
-            "--target",
-            target,
-        ];
-        if run(cargo(&args)).0 {
-            println!("{core} ({target}): panic_never links: no reachable panic path");
-            passed += 1;
-        } else {
-            failed += 1;
-            println!("{core} ({target}): a panic path is reachable; call sites:");
-            let mut list = args.to_vec();
-            list[5] = "list-panics";
-            if run(cargo(&list)).0 {
-                for site in panic_sites(&elf(target, "release", "panic_never")) {
-                    println!("  {site}");
+    for bin in ["panic_never", "panic_never_accels"] {
+        for (target, core, _, _) in TARGETS {
+            let args = [
+                "build",
+                "--release",
+                "--bin",
+                bin,
+                "--features",
+                "panic-check",
+                "--target",
+                target,
+            ];
+            if run(cargo(&args)).0 {
+                println!("{core} ({target}): {bin} links: no reachable panic path");
+                passed += 1;
+            } else {
+                failed += 1;
+                println!("{core} ({target}): {bin}: a panic path is reachable; call sites:");
+                let mut list = args.to_vec();
+                list[5] = "list-panics";
+                if run(cargo(&list)).0 {
+                    for site in panic_sites(&elf(target, "release", bin)) {
+                        println!("  {site}");
+                    }
                 }
             }
         }

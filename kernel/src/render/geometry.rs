@@ -14,7 +14,9 @@
 
 use super::scene::{Object, Shape};
 use super::{AccelChoice, SceneError};
-use crate::accel::bvh::{nodes_needed, Bvh, Node};
+use crate::accel::bvh::{self, Bvh, Node};
+use crate::accel::grid::Grid;
+use crate::accel::kdtree::{self, KdNode, KdTree};
 use crate::accel::{Accel, Counters, Linear};
 use crate::error::BuildError;
 use crate::geom::spawn::{self, cross, sub, unit, SpawnScalar, MAX_NUDGES};
@@ -37,6 +39,8 @@ pub const MAX_LIGHTS: usize = 8;
 enum Index<'a, S: Scalar, P: Primitive<S>> {
     Linear(Linear<'a, S, P>),
     Bvh(Bvh<'a, S, P>),
+    Grid(Grid<'a, S, P>),
+    KdTree(KdTree<'a, S, P>),
 }
 
 impl<S: Scalar, P: Primitive<S>> Index<'_, S, P> {
@@ -45,6 +49,8 @@ impl<S: Scalar, P: Primitive<S>> Index<'_, S, P> {
         match self {
             Self::Linear(a) => a.intersect_counted(ray, c),
             Self::Bvh(a) => a.intersect_counted(ray, c),
+            Self::Grid(a) => a.intersect_counted(ray, c),
+            Self::KdTree(a) => a.intersect_counted(ray, c),
         }
     }
     #[inline]
@@ -52,7 +58,93 @@ impl<S: Scalar, P: Primitive<S>> Index<'_, S, P> {
         match self {
             Self::Linear(a) => a.occluded_counted(ray, c),
             Self::Bvh(a) => a.occluded_counted(ray, c),
+            Self::Grid(a) => a.occluded_counted(ray, c),
+            Self::KdTree(a) => a.occluded_counted(ray, c),
         }
+    }
+}
+
+/// The caller's memory for the renderer's accelerators: one buffer per element type, each at
+/// least as long as [`memory_needed`] gives for the chosen [`AccelChoice`] (longer is fine).
+/// Objects take their share from the front, in scene order.
+#[derive(Debug)]
+pub struct AccelMemory<'a, S: Scalar> {
+    /// BVH nodes ([`AccelChoice::Bvh`]).
+    pub bvh_nodes: &'a mut [Node<S>],
+    /// Kd-tree nodes ([`AccelChoice::KdTree`]).
+    pub kd_nodes: &'a mut [KdNode<S>],
+    /// Index words: BVH primitive ids, grid cell offsets and references, kd-tree references.
+    pub words: &'a mut [u32],
+}
+
+impl<S: Scalar> Default for AccelMemory<'_, S> {
+    /// No memory: enough for [`AccelChoice::Linear`].
+    fn default() -> Self {
+        Self {
+            bvh_nodes: &mut [],
+            kd_nodes: &mut [],
+            words: &mut [],
+        }
+    }
+}
+
+/// Buffer lengths (elements, not bytes) a scene needs for an [`AccelChoice`]: the sums over
+/// its objects.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MemoryNeeded {
+    /// Length of [`AccelMemory::bvh_nodes`].
+    pub bvh_nodes: usize,
+    /// Length of [`AccelMemory::kd_nodes`].
+    pub kd_nodes: usize,
+    /// Length of [`AccelMemory::words`].
+    pub words: usize,
+}
+
+impl MemoryNeeded {
+    /// The total in bytes for mode `S`.
+    #[must_use]
+    pub const fn bytes<S: Scalar>(&self) -> usize {
+        self.bvh_nodes
+            .saturating_mul(core::mem::size_of::<Node<S>>())
+            .saturating_add(
+                self.kd_nodes
+                    .saturating_mul(core::mem::size_of::<KdNode<S>>()),
+            )
+            .saturating_add(self.words.saturating_mul(4))
+    }
+
+    fn add(self, o: Self) -> Self {
+        Self {
+            bvh_nodes: self.bvh_nodes.saturating_add(o.bvh_nodes),
+            kd_nodes: self.kd_nodes.saturating_add(o.kd_nodes),
+            words: self.words.saturating_add(o.words),
+        }
+    }
+}
+
+/// What one object's primitives need. A grid the counting pass rejects needs nothing here:
+/// its build reports the error.
+fn needed_for<S: Scalar, P: Primitive<S>>(prims: &[P], choice: AccelChoice) -> MemoryNeeded {
+    let n = prims.len();
+    let none = MemoryNeeded::default();
+    match choice {
+        AccelChoice::Linear => none,
+        AccelChoice::Bvh(_) => MemoryNeeded {
+            bvh_nodes: bvh::nodes_needed(n),
+            words: n,
+            ..none
+        },
+        AccelChoice::Grid(options) => {
+            Grid::<S, P>::size_for(prims, options).map_or(none, |g| MemoryNeeded {
+                words: g.cells.saturating_add(g.refs),
+                ..none
+            })
+        }
+        AccelChoice::KdTree(_) => MemoryNeeded {
+            kd_nodes: kdtree::nodes_needed(n),
+            words: kdtree::refs_needed(n),
+            ..none
+        },
     }
 }
 
@@ -68,8 +160,7 @@ fn take<'a, T>(buf: &mut &'a mut [T], n: usize) -> &'a mut [T] {
 fn build_index<'a, S: Scalar, P: Primitive<S>>(
     prims: &'a [P],
     choice: AccelChoice,
-    nodes: &mut &'a mut [Node<S>],
-    ids: &mut &'a mut [u32],
+    memory: &mut AccelMemory<'a, S>,
 ) -> Result<Index<'a, S, P>, BuildError> {
     match choice {
         AccelChoice::Linear => {
@@ -84,12 +175,20 @@ fn build_index<'a, S: Scalar, P: Primitive<S>>(
             Ok(Index::Linear(Linear::new(prims)))
         }
         AccelChoice::Bvh(options) => {
-            let n = nodes_needed(prims.len());
-            let node_slots = take(nodes, n);
-            let id_slots = take(ids, prims.len());
-            Ok(Index::Bvh(Bvh::build(
-                prims, node_slots, id_slots, options,
-            )?))
+            let nodes = take(&mut memory.bvh_nodes, bvh::nodes_needed(prims.len()));
+            let ids = take(&mut memory.words, prims.len());
+            Ok(Index::Bvh(Bvh::build(prims, nodes, ids, options)?))
+        }
+        AccelChoice::Grid(options) => {
+            let size = Grid::<S, P>::size_for(prims, options)?;
+            let cells = take(&mut memory.words, size.cells);
+            let refs = take(&mut memory.words, size.refs);
+            Ok(Index::Grid(Grid::build(prims, cells, refs, options)?))
+        }
+        AccelChoice::KdTree(options) => {
+            let nodes = take(&mut memory.kd_nodes, kdtree::nodes_needed(prims.len()));
+            let refs = take(&mut memory.words, kdtree::refs_needed(prims.len()));
+            Ok(Index::KdTree(KdTree::build(prims, nodes, refs, options)?))
         }
     }
 }
@@ -168,12 +267,14 @@ pub(crate) struct Geometry<'a, S: Scalar> {
     light_base: u32,
 }
 
-/// Node and id slots a scene needs with [`AccelChoice::Bvh`]: the sums over its objects.
+/// Buffer lengths a scene's objects need with `choice` (all zero for `Linear`).
 #[must_use]
-pub fn memory_needed<S: Scalar>(objects: &[Object<'_, S>]) -> (usize, usize) {
-    objects.iter().fold((0, 0), |(n, i), o| {
-        let len = o.shape.len();
-        (n.saturating_add(nodes_needed(len)), i.saturating_add(len))
+pub fn memory_needed<S: Scalar>(objects: &[Object<'_, S>], choice: AccelChoice) -> MemoryNeeded {
+    objects.iter().fold(MemoryNeeded::default(), |sum, o| {
+        sum.add(match o.shape {
+            Shape::Triangles(t) => needed_for(t, choice),
+            Shape::Spheres(s) => needed_for(s, choice),
+        })
     })
 }
 
@@ -183,13 +284,12 @@ fn shifted<S: SpawnScalar>(p: [S; 3], d: [f64; 3], sign: f64) -> [S; 3] {
 }
 
 impl<'a, S: SpawnScalar> Geometry<'a, S> {
-    /// Builds every object's accelerator into the caller's buffers (BVH: [`memory_needed`]).
+    /// Builds every object's accelerator into the caller's memory ([`memory_needed`]).
     pub(crate) fn build(
         objects: &'a [Object<'a, S>],
         lights: &[Light],
         choice: AccelChoice,
-        mut nodes: &'a mut [Node<S>],
-        mut ids: &'a mut [u32],
+        mut memory: AccelMemory<'a, S>,
     ) -> Result<Self, SceneError> {
         let err = |index, field, problem| SceneError::new(Item::Object, index, field, problem);
         if objects.len() > MAX_OBJECTS {
@@ -203,21 +303,14 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
                 Problem::TooMany { max: MAX_LIGHTS },
             ));
         }
-        if let AccelChoice::Bvh(_) = choice {
-            let (n, i) = memory_needed(objects);
-            if nodes.len() < n {
-                let p = Problem::TooSmall {
-                    needed: n,
-                    available: nodes.len(),
-                };
-                return Err(err(0, "nodes", p));
-            }
-            if ids.len() < i {
-                let p = Problem::TooSmall {
-                    needed: i,
-                    available: ids.len(),
-                };
-                return Err(err(0, "prim_ids", p));
+        let need = memory_needed(objects, choice);
+        for (field, needed, available) in [
+            ("bvh_nodes", need.bvh_nodes, memory.bvh_nodes.len()),
+            ("kd_nodes", need.kd_nodes, memory.kd_nodes.len()),
+            ("words", need.words, memory.words.len()),
+        ] {
+            if available < needed {
+                return Err(err(0, field, Problem::TooSmall { needed, available }));
             }
         }
         let mut geo = Self {
@@ -233,13 +326,11 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
             }
             let (index, bounds) = match o.shape {
                 Shape::Triangles(t) => (
-                    ShapeIndex::Triangles(
-                        build_index(t, choice, &mut nodes, &mut ids).map_err(bad)?,
-                    ),
+                    ShapeIndex::Triangles(build_index(t, choice, &mut memory).map_err(bad)?),
                     union_bounds(t),
                 ),
                 Shape::Spheres(s) => (
-                    ShapeIndex::Spheres(build_index(s, choice, &mut nodes, &mut ids).map_err(bad)?),
+                    ShapeIndex::Spheres(build_index(s, choice, &mut memory).map_err(bad)?),
                     union_bounds(s),
                 ),
             };

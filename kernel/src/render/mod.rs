@@ -3,7 +3,7 @@
 //! the shutter interval. `no_std`, no allocation, both number modes.
 //!
 //! - The caller owns the scene ([`Scene`]: objects, materials, lights, camera) and the memory
-//!   (BVH nodes and ids, sized by [`memory_needed`]; the framebuffer).
+//!   ([`AccelMemory`] for the accelerators, sized by [`memory_needed`]; the framebuffer).
 //! - [`Renderer::new`] checks the scene (typed [`SceneError`]s), builds one accelerator per
 //!   object and derives the [`RenderPlan`]: the features the scene and settings need. Features
 //!   the plan leaves out cost a branch, not work.
@@ -23,13 +23,17 @@ pub mod sampling;
 mod scene;
 pub mod scenes;
 
-pub use geometry::{memory_needed, MAX_LIGHTS, MAX_OBJECTS, SPHERE_SPAWN_FACTOR};
+pub use geometry::{
+    memory_needed, AccelMemory, MemoryNeeded, MAX_LIGHTS, MAX_OBJECTS, SPHERE_SPAWN_FACTOR,
+};
 pub use sampling::SamplerKind;
 pub use scene::{
     Camera, Filter, Item, Light, Material, Object, Problem, Rgb, Scene, SceneError, Settings, Shape,
 };
 
-use crate::accel::bvh::{BuildOptions, Node};
+use crate::accel::bvh::BuildOptions;
+use crate::accel::grid::GridOptions;
+use crate::accel::kdtree::KdOptions;
 use crate::geom::spawn::SpawnScalar;
 use camera::CameraFrame;
 use core::fmt;
@@ -37,13 +41,18 @@ use geometry::Geometry;
 use glam::Vec3;
 use sampling::Sampler;
 
-/// Which accelerator every object is built into.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Which accelerator every object is built into. Every choice gives the same image, bit for
+/// bit (the accelerators return the same closest hit, ties to the lowest id).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum AccelChoice {
     /// Brute force (no memory needed): the reference.
     Linear,
-    /// A BVH per object, built with these options into the caller's node and id buffers.
+    /// A BVH per object: [`AccelMemory::bvh_nodes`] and [`AccelMemory::words`] (primitive ids).
     Bvh(BuildOptions),
+    /// A uniform grid per object: [`AccelMemory::words`] (cell offsets and references).
+    Grid(GridOptions),
+    /// A kd-tree per object: [`AccelMemory::kd_nodes`] and [`AccelMemory::words`] (references).
+    KdTree(KdOptions),
 }
 
 impl Default for AccelChoice {
@@ -194,9 +203,9 @@ pub struct Renderer<'a, S: SpawnScalar> {
 }
 
 impl<'a, S: SpawnScalar> Renderer<'a, S> {
-    /// Checks the scene and settings, builds the accelerators into `nodes` and `prim_ids`
-    /// (for [`AccelChoice::Bvh`]: at least [`memory_needed`] slots; unused for `Linear`) and
-    /// derives the plan.
+    /// Checks the scene and settings, builds the accelerators into `memory` (at least what
+    /// [`memory_needed`] gives for `accel`; [`AccelMemory::default`], empty, for `Linear`) and derives the
+    /// plan.
     ///
     /// # Errors
     /// A [`SceneError`] naming the item, its index, the field and the problem: bad settings,
@@ -206,15 +215,14 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
         scene: &Scene<'a, S>,
         settings: Settings,
         accel: AccelChoice,
-        nodes: &'a mut [Node<S>],
-        prim_ids: &'a mut [u32],
+        memory: AccelMemory<'a, S>,
     ) -> Result<Self, SceneError> {
         check_settings(&settings)?;
         check_materials(scene)?;
         let camera = CameraFrame::new(&scene.camera, settings.width, settings.height)?;
         scene::check_rgb(scene.background, false)
             .map_err(|p| SceneError::new(Item::Settings, 0, "background", p))?;
-        let geometry = Geometry::build(scene.objects, scene.lights, accel, nodes, prim_ids)?;
+        let geometry = Geometry::build(scene.objects, scene.lights, accel, memory)?;
         Ok(Self {
             geometry,
             materials: scene.materials,

@@ -368,6 +368,21 @@ impl Scalar for I16F16 {
     }
 
     #[inline(always)]
+    fn slab_axis(r: &FixedRay, axis: usize, lo: Self, hi: Self) -> (Self, Self) {
+        // The same integer steps as one axis of `slab`, clamped into range (monotone).
+        let i = axis.min(2);
+        let a = (((lo.0 as i64 - r.o_lo[i]) as i128 * r.recip[i] as i128) >> 32) as i64;
+        let b = (((hi.0 as i64 - r.o_hi[i]) as i128 * r.recip[i] as i128) >> 32) as i64;
+        let clamp = |x: i64| I16F16(x.clamp(i32::MIN as i64, i32::MAX as i64) as i32);
+        (clamp(a.min(b) - SLAB_PAD), clamp(a.max(b) + SLAB_PAD))
+    }
+
+    #[inline(always)]
+    fn axis_negative(r: &FixedRay, axis: usize) -> bool {
+        r.dir[axis.min(2)] < 0
+    }
+
+    #[inline(always)]
     fn widen(t: Self) -> Self {
         I16F16(t.0.saturating_add(SLAB_PAD as i32))
     }

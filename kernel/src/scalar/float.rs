@@ -354,6 +354,27 @@ impl Scalar for f32 {
     }
 
     #[inline(always)]
+    fn slab_axis(r: &FloatRay, axis: usize, lo: f32, hi: f32) -> (f32, f32) {
+        // The same IEEE operations as one lane of `slab`, so the same bits.
+        let i = axis.min(2);
+        let a = (lo - r.o_lo[i]) * r.inv[i];
+        let b = (hi - r.o_hi[i]) * r.inv[i];
+        let near = if a < b { a } else { b };
+        let far = if a > b { a } else { b };
+        // `slab` ignores a lane whose `near` is NaN (NaN in `b`); a NaN in `a` leaves (b, b).
+        if near.is_nan() {
+            (f32::NEG_INFINITY, f32::INFINITY)
+        } else {
+            (near, Self::widen(far))
+        }
+    }
+
+    #[inline(always)]
+    fn axis_negative(r: &FloatRay, axis: usize) -> bool {
+        r.inv[axis.min(2)] < 0.0
+    }
+
+    #[inline(always)]
     fn widen(t: f32) -> f32 {
         // Only non-negative ends matter (t_near >= t_min >= 0); negative ones stay negative.
         // Multiplying keeps ±inf as they are.

@@ -106,6 +106,21 @@ pub trait Scalar:
     /// `widen(t)`.
     #[must_use]
     fn widen(t: Self) -> Self;
+    /// The per-axis part of [`Scalar::slab`], for traversals that walk cells plane by plane
+    /// (the uniform grid): `(entry, exit)` of the ray between the planes `lo <= hi` of `axis`,
+    /// the exit already widened.
+    ///
+    /// Contract (tested against `slab`): `slab(ray, lo, hi, t_min, t_max)` returns `Some(e)`
+    /// exactly when `e = max(t_min, entry_0, entry_1, entry_2) <= min(widen(t_max), exit_0,
+    /// exit_1, exit_2)`; in fixed point values beyond the range are clamped to it, which can
+    /// only add acceptances at the range end. An axis that constrains nothing (`f32`: a zero
+    /// direction component whose shifted origin lies on the `hi` plane) gives `(-inf, +inf)`.
+    /// Both ends are nondecreasing in `lo` and `hi` when [`Scalar::axis_negative`] is false and
+    /// nonincreasing when it is true (including zero direction components).
+    fn slab_axis(ray: &Self::RayData, axis: usize, lo: Self, hi: Self) -> (Self, Self);
+    /// True if the ray runs towards decreasing coordinates on `axis` as the slab test sees it
+    /// (in `f32` a `-0` component counts as negative: its reciprocal is `-inf`).
+    fn axis_negative(ray: &Self::RayData, axis: usize) -> bool;
 
     /// Distance to a two-sided triangle if it is hit within `[t_min, t_max]`.
     /// Degenerate triangles are never hit.

@@ -3,8 +3,8 @@
 
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::{
-    Accel, Bvh, Hit, Node, PointError, Primitive, Ray, Scalar, F32_COORD_LIMIT, FIXED_COORD_LIMIT,
-    I16F16,
+    kdtree, Accel, Bvh, Grid, GridOptions, Hit, KdNode, KdOptions, KdTree, Node, PointError,
+    Primitive, Ray, Scalar, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16,
 };
 use std::fmt;
 use std::ops::{Add, Mul, Sub};
@@ -192,6 +192,77 @@ where
         )
     });
     f(&bvh)
+}
+
+/// Grid densities the differential tests build with: coarse, the default, fine.
+pub const GRID_DENSITIES: [f32; 3] = [0.25, raykernel::grid::DEFAULT_DENSITY, 8.0];
+/// Kd-tree depth limits the differential tests build with (0 = the automatic rule).
+pub const KD_DEPTHS: [u32; 3] = [0, 3, kdtree::MAX_DEPTH];
+
+/// Builds a uniform grid into arenas of exactly the size the counting pass reports, checks
+/// `validate()`, and hands it to `f`.
+pub fn with_grid<S, P, R>(
+    prims: &[P],
+    options: GridOptions,
+    f: impl FnOnce(&Grid<'_, S, P>) -> R,
+) -> R
+where
+    S: Scalar,
+    P: Primitive<S>,
+{
+    let size = Grid::size_for(prims, options).unwrap_or_else(|e| {
+        panic!(
+            "{} grid size ({} prims, {options:?}): {e}",
+            S::NAME,
+            prims.len()
+        )
+    });
+    let mut cells = vec![0u32; size.cells];
+    let mut refs = vec![0u32; size.refs];
+    let grid = Grid::build(prims, &mut cells, &mut refs, options).unwrap_or_else(|e| {
+        panic!(
+            "{} grid build ({} prims, {options:?}): {e}",
+            S::NAME,
+            prims.len()
+        )
+    });
+    grid.validate()
+        .unwrap_or_else(|e| panic!("{} grid ({options:?}): {e}", S::NAME));
+    assert_eq!(grid.refs().len(), size.refs, "counting pass must be exact");
+    f(&grid)
+}
+
+/// Builds a kd-tree into arenas of exactly the documented budgets, checks `validate()`, and
+/// hands it to `f`.
+pub fn with_kdtree<S, P, R>(
+    prims: &[P],
+    options: KdOptions,
+    f: impl FnOnce(&KdTree<'_, S, P>) -> R,
+) -> R
+where
+    S: Scalar,
+    P: Primitive<S>,
+{
+    let mut nodes = vec![KdNode::<S>::EMPTY; kdtree::nodes_needed(prims.len())];
+    let mut refs = vec![0u32; kdtree::refs_needed(prims.len())];
+    let tree = KdTree::build(prims, &mut nodes, &mut refs, options).unwrap_or_else(|e| {
+        panic!(
+            "{} kd-tree build ({} prims, {options:?}): {e}",
+            S::NAME,
+            prims.len()
+        )
+    });
+    let stats = tree
+        .validate()
+        .unwrap_or_else(|e| panic!("{} kd-tree ({options:?}): {e}", S::NAME));
+    if options.max_depth > 0 {
+        assert!(
+            stats.depth <= options.max_depth as usize,
+            "{} kd-tree too deep",
+            S::NAME
+        );
+    }
+    f(&tree)
 }
 
 /// Every (builder, leaf size) combination the differential tests cover.
