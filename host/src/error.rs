@@ -50,6 +50,8 @@ pub enum Error {
     },
     /// Arguments that parse but do not go together (exit code 2, like clap's).
     Usage(String),
+    /// `host bench`: a missing input (scenes, ray files, the ray script) or a failed step.
+    Bench(String),
     /// Two hit files to compare hold different numbers of records.
     HitCountMismatch {
         /// The reference file and its record count.
@@ -99,6 +101,7 @@ impl fmt::Display for Error {
                 None => write!(f, "{}: {msg}", path.display()),
             },
             Self::Usage(msg) => f.write_str(msg),
+            Self::Bench(msg) => write!(f, "bench: {msg}"),
             Self::HitCountMismatch { reference, other } => write!(
                 f,
                 "hit files differ in length: {} has {} records, {} has {}",
@@ -121,6 +124,7 @@ impl std::error::Error for Error {
             Self::RunsDiffer { .. }
             | Self::Camera { .. }
             | Self::Usage(_)
+            | Self::Bench(_)
             | Self::HitCountMismatch { .. } => None,
         }
     }

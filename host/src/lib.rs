@@ -8,10 +8,12 @@
 //! - [`classify`]: whether rays on which two hit files differ pass within quantization error of
 //!   an edge,
 //! - [`scene`], [`render`]: the built-in scene, cameras, and a primary-ray renderer (PNG out),
+//! - [`bench`]: `host bench`, speed and accuracy with peers in one run (report, data, plots),
 //! - [`cli`]: the command line (clap) and the commands behind it,
 //! - [`error`]: the error type `main` turns into a message and an exit code.
 #![forbid(unsafe_code)]
 
+pub mod bench;
 pub mod classify;
 pub mod cli;
 pub mod compare;
