@@ -395,7 +395,7 @@ impl<S: Scalar> NodeArena<S> {
 
     /// The `slots` requested, starting on a 64-byte boundary.
     fn slots(&mut self) -> &mut [Node<S>] {
-        let misaligned = self.nodes.as_ptr() as usize % Self::LINE != 0;
+        let misaligned = !(self.nodes.as_ptr() as usize).is_multiple_of(Self::LINE);
         let skip = usize::from(misaligned);
         let len = self.nodes.len() - 1;
         &mut self.nodes[skip..skip + len]

@@ -72,17 +72,11 @@ impl Reference {
         stride: usize,
         threads: usize,
     ) -> Result<Self, raykernel::BuildError> {
-        let kernel_tris: Vec<Triangle<f32>> = tris
-            .iter()
-            .map(|t| Triangle { v: *t })
-            .collect();
+        let kernel_tris: Vec<Triangle<f32>> = tris.iter().map(|t| Triangle { v: *t }).collect();
         let mut nodes = vec![Node::<f32>::EMPTY; nodes_needed(tris.len())];
         let mut ids = vec![0u32; tris.len()];
         let bvh = Bvh::build(&kernel_tris, &mut nodes, &mut ids, BuildOptions::default())?;
-        let tris64: Vec<[[f64; 3]; 3]> = tris
-            .iter()
-            .map(|t| t.map(|p| p.map(f64::from)))
-            .collect();
+        let tris64: Vec<[[f64; 3]; 3]> = tris.iter().map(|t| t.map(|p| p.map(f64::from))).collect();
         let rays: Vec<Option<RefRay>> = records
             .iter()
             .step_by(stride.max(1))
@@ -167,7 +161,11 @@ impl Reference {
                 }
             }
         }
-        a.t_rel_mean = if counted > 0 { sum / counted as f64 } else { 0.0 };
+        a.t_rel_mean = if counted > 0 {
+            sum / counted as f64
+        } else {
+            0.0
+        };
         a
     }
 }
@@ -257,8 +255,13 @@ fn closest(
         }
         let first = node.first() as usize;
         if node.is_leaf() {
-            for &id in ids.get(first..first + node.count() as usize).unwrap_or_default() {
-                let Some(tri) = tris.get(id as usize) else { continue };
+            for &id in ids
+                .get(first..first + node.count() as usize)
+                .unwrap_or_default()
+            {
+                let Some(tri) = tris.get(id as usize) else {
+                    continue;
+                };
                 if let Some(t) = wbw.hit(tri, ray.t_min, t_max) {
                     let better = match best {
                         None => true,
@@ -355,7 +358,10 @@ mod tests {
             RayRecord::new([0.0, 0.0, 20.0], [0.0, 0.0, -1.0]),
         ];
         let r = Reference::compute(&quad(), &rays, 1, 2).unwrap();
-        assert_eq!(r.hits, vec![Some((5.0, 0)), Some((5.0, 0)), None, Some((11.0, 2))]);
+        assert_eq!(
+            r.hits,
+            vec![Some((5.0, 0)), Some((5.0, 0)), None, Some((11.0, 2))]
+        );
         let hit = |t, prim| HitRecord { t, prim };
         let a = r.accuracy(&[hit(5.0, 0), hit(5.0, 1), hit(6.0, 0), HitRecord::MISS]);
         assert_eq!((a.ties, a.false_hits, a.leaks, a.wrong_prim), (1, 1, 1, 0));

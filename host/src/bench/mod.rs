@@ -143,9 +143,8 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
         slopes: Vec::new(),
         elapsed_s: 0.0,
     };
-    std::fs::create_dir_all(&config.out).map_err(|e| {
-        Error::Bench(format!("cannot create {}: {e}", config.out.display()))
-    })?;
+    std::fs::create_dir_all(&config.out)
+        .map_err(|e| Error::Bench(format!("cannot create {}: {e}", config.out.display())))?;
     results.elapsed_s = start.elapsed().as_secs_f64();
     let written = report::write_all(&mut results, &config.out)?;
     Ok((results, written))

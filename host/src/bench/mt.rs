@@ -70,7 +70,7 @@ pub fn moller_trumbore(
     // Barycentrics, NaN-safe (a NaN fails every `>=`).
     let s = sub(o, v[0]);
     let u = dot(s, p) * inv;
-    if !(u >= 0.0 && u <= 1.0) {
+    if !(0.0..=1.0).contains(&u) {
         return None;
     }
     let q = cross(s, e1);

@@ -231,7 +231,7 @@ fn empty_measured() -> PeerMeasured {
     }
 }
 
-/// Closest hit `runs` times, any hit `runs` times, one counted closest pass.
+/// Closest hit `runs` times, any hit once, one counted closest pass.
 fn obvhs_queries<B: ObvhsQueries>(
     bvh: &B,
     tris: &[obvhs::triangle::Triangle],
@@ -250,15 +250,19 @@ fn obvhs_queries<B: ObvhsQueries>(
             if bvh.closest(*ray, &mut hit, test) {
                 *slot = HitRecord {
                     t: hit.t,
-                    prim: ids.get(hit.primitive_id as usize).copied().unwrap_or(u32::MAX),
+                    prim: ids
+                        .get(hit.primitive_id as usize)
+                        .copied()
+                        .unwrap_or(u32::MAX),
                 };
             }
         }
         closest.push(millis(start));
     }
+    // Any hit timed once, as for ours.
     let mut any = Vec::new();
-    let mut any_hits = 0;
-    for _ in 0..runs {
+    let any_hits;
+    {
         let start = Instant::now();
         let mut n = 0usize;
         for ray in rays {
@@ -330,7 +334,12 @@ struct SvenRay {
 
 /// Closest hit through `nearest_traverse_iterator` (shapes in order of box entry), stopping
 /// at the first box entered beyond the best hit; ties to the lower id, as ours.
-fn sven_closest(bvh: &bvh::bvh::Bvh<f32, 3>, shapes: &[SvenTri], r: &SvenRay, count: &mut u64) -> HitRecord {
+fn sven_closest(
+    bvh: &bvh::bvh::Bvh<f32, 3>,
+    shapes: &[SvenTri],
+    r: &SvenRay,
+    count: &mut u64,
+) -> HitRecord {
     use bvh::aabb::Bounded;
     let mut best = HitRecord::MISS;
     for s in bvh.nearest_traverse_iterator(&r.ray, shapes) {
@@ -376,6 +385,7 @@ fn svenstaro_run(
     let mut hits = vec![HitRecord::MISS; rays.len()];
     let mut shapes = Vec::new();
     let mut tree = None;
+    let mut tested = 0u64;
     for _ in 0..runs {
         shapes = tris
             .iter()
@@ -390,19 +400,21 @@ fn svenstaro_run(
         let bvh = bvh::bvh::Bvh::build(&mut shapes);
         builds.push(millis(start));
         let start = Instant::now();
+        // Counting the tests is one increment per test, negligible beside the test itself.
         let mut count = 0u64;
         for (slot, r) in hits.iter_mut().zip(&rays) {
             *slot = sven_closest(&bvh, &shapes, r, &mut count);
         }
         closest.push(millis(start));
+        tested = count;
         tree = Some(bvh);
     }
     let Some(bvh) = tree else {
         return empty_measured();
     };
     let mut any = Vec::new();
-    let mut any_hits = 0;
-    for _ in 0..runs {
+    let any_hits;
+    {
         let start = Instant::now();
         let mut n = 0usize;
         for r in &rays {
@@ -413,10 +425,6 @@ fn svenstaro_run(
         }
         any.push(millis(start));
         any_hits = black_box(n);
-    }
-    let mut tested = 0u64;
-    for r in &rays {
-        black_box(sven_closest(&bvh, &shapes, r, &mut tested));
     }
     PeerMeasured {
         build_ms: median(&builds),

@@ -122,9 +122,9 @@ pub fn loglog(
             .label(label)
             .legend(move |(x, y)| Circle::new((x + 8, y), 5, c.filled()));
         if let Some((slope, icpt)) = fit {
-            let (lo, hi) = pts
-                .iter()
-                .fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
+            let (lo, hi) = pts.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| {
+                (a.min(p.0), b.max(p.0))
+            });
             let line = [lo, hi].map(|x| (x, (icpt + slope * x.ln()).exp()));
             chart
                 .draw_series(LineSeries::new(line, c.stroke_width(2)))
@@ -193,10 +193,14 @@ pub fn grouped_bars(
     let width = 0.8 / k;
     for (i, (name, values)) in series.iter().enumerate() {
         let c = color(i);
-        let bars = values.iter().enumerate().filter(|(_, v)| **v > 0.0).map(|(g, &v)| {
-            let x = g as f64 - 0.4 + width * i as f64;
-            Rectangle::new([(x, 0.0), (x + width * 0.9, v)], c.filled())
-        });
+        let bars = values
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| **v > 0.0)
+            .map(|(g, &v)| {
+                let x = g as f64 - 0.4 + width * i as f64;
+                Rectangle::new([(x, 0.0), (x + width * 0.9, v)], c.filled())
+            });
         chart
             .draw_series(bars)
             .map_err(|e| plot_error(path, e))?

@@ -140,20 +140,21 @@ fn draw_plots(results: &mut BenchResults, dir: &Path) -> Result<Vec<PathBuf>, Er
         }
         // Speed: closest-hit Mrays/s per scene.
         let path = dir.join(format!("speed_{}.png", kind.name()));
-        let series: Vec<(String, Vec<f64>)> = labels(&results.rows, |r| r.rays == kind && headline(r))
-            .into_iter()
-            .map(|label| {
-                let values = scene_names
-                    .iter()
-                    .map(|s| {
-                        rows.iter()
-                            .find(|r| &r.scene == s && r.label() == label)
-                            .map_or(0.0, |r| r.closest_mrays)
-                    })
-                    .collect();
-                (label, values)
-            })
-            .collect();
+        let series: Vec<(String, Vec<f64>)> =
+            labels(&results.rows, |r| r.rays == kind && headline(r))
+                .into_iter()
+                .map(|label| {
+                    let values = scene_names
+                        .iter()
+                        .map(|s| {
+                            rows.iter()
+                                .find(|r| &r.scene == s && r.label() == label)
+                                .map_or(0.0, |r| r.closest_mrays)
+                        })
+                        .collect();
+                    (label, values)
+                })
+                .collect();
         grouped_bars(
             &path,
             &format!("Closest hit, {} rays, single thread", kind.name()),
@@ -185,7 +186,10 @@ fn draw_plots(results: &mut BenchResults, dir: &Path) -> Result<Vec<PathBuf>, Er
             .collect();
         let fitted = loglog(
             &path,
-            &format!("Mean relative hit-distance error vs speed, {} rays", kind.name()),
+            &format!(
+                "Mean relative hit-distance error vs speed, {} rays",
+                kind.name()
+            ),
             "closest hit, Mrays/s",
             "mean |t - t*| / t*",
             &series,
@@ -375,7 +379,10 @@ pub fn markdown(r: &BenchResults) -> String {
 
 fn headline_section(s: &mut String, r: &BenchResults) {
     let peers = labels(&r.rows, |x| !x.ours);
-    let _ = writeln!(s, "## Headline: closest hit, Mrays/s, ours and peers in the same run\n");
+    let _ = writeln!(
+        s,
+        "## Headline: closest hit, Mrays/s, ours and peers in the same run\n"
+    );
     let _ = writeln!(
         s,
         "Ratios are raykernel `f32` (SAH BVH, watertight) ÷ peer: above 1 means ours is faster.\n"
@@ -427,10 +434,13 @@ fn headline_section(s: &mut String, r: &BenchResults) {
 }
 
 fn ours_section(s: &mut String, r: &BenchResults) {
-    let _ = writeln!(s, "## Traversal: every accelerator, builder and mode of the kernel\n");
     let _ = writeln!(
         s,
-        "Leaves of up to 4 primitives. `any hit` is `occluded` (first hit in range). Nodes \
+        "## Traversal: every accelerator, builder and mode of the kernel\n"
+    );
+    let _ = writeln!(
+        s,
+        "Leaves of up to 4 primitives. `any hit` is `occluded` (first hit in range), timed once on the last run. Nodes \
          and primitives are counted per closest-hit ray. Bytes per triangle count the nodes \
          in use and the primitive ids (not the triangles). `MT` is the benchmark-only \
          Möller–Trumbore test on the same tree (a contrast, not part of the kernel).\n"
@@ -439,7 +449,10 @@ fn ours_section(s: &mut String, r: &BenchResults) {
         s,
         "| scene | rays | accel | builder | mode | test | build ms | closest Mrays/s | any-hit Mrays/s | setup ms | nodes/ray | prims/ray | bytes/tri | depth |"
     );
-    let _ = writeln!(s, "|---|---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(
+        s,
+        "|---|---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
     for x in r.rows.iter().filter(|x| x.ours) {
         let _ = writeln!(
             s,
@@ -477,7 +490,10 @@ fn peers_section(s: &mut String, r: &BenchResults) {
         s,
         "| scene | rays | peer | build ms | build ratio | closest Mrays/s | ratio | any-hit Mrays/s | ratio | prims/ray | bytes/tri | agree % | ties | hit/miss | hits ours / peer |"
     );
-    let _ = writeln!(s, "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(
+        s,
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
     for x in r.rows.iter().filter(|x| !x.ours) {
         let Some(ours) = our_reference(&r.rows, &x.scene, x.rays) else {
             continue;

@@ -121,11 +121,8 @@ pub fn tiled_scene(meshes: &[&Mesh], target: usize, seed: u64) -> Option<Tiled> 
             ]);
         }
         let take = left.min(s.mesh.triangles.len());
-        mesh.triangles.extend(
-            s.mesh.triangles[..take]
-                .iter()
-                .map(|t| t.map(|i| i + base)),
-        );
+        mesh.triangles
+            .extend(s.mesh.triangles[..take].iter().map(|t| t.map(|i| i + base)));
         left -= take;
     }
     // Ground: (cols+1)×(rows+1) vertices, two triangles per cell.
@@ -216,7 +213,10 @@ fn measure_size<S: Scalar>(
     opts: &ScaleOptions,
 ) -> Result<ScaleRow, Error> {
     let tris = tiled.mesh.kernel_triangles::<S>(path)?;
-    let (p, q) = (prepare_rays::<S>(primary, 1), prepare_rays::<S>(incoherent, 1));
+    let (p, q) = (
+        prepare_rays::<S>(primary, 1),
+        prepare_rays::<S>(incoherent, 1),
+    );
     let config = AccelConfig {
         accel: AccelKind::Bvh,
         build: BuildOptions::default(),
@@ -319,7 +319,10 @@ mod tests {
         for t in &a.mesh.triangles[..7] {
             for &i in t {
                 let p = a.mesh.positions[i as usize];
-                assert!(p[1] >= 0.0 && p[0].abs() <= 10.0 && p[2].abs() <= 10.0, "{p:?}");
+                assert!(
+                    p[1] >= 0.0 && p[0].abs() <= 10.0 && p[2].abs() <= 10.0,
+                    "{p:?}"
+                );
             }
         }
     }

@@ -30,7 +30,10 @@ mod tests {
 
     #[test]
     fn recovers_a_power_law() {
-        let pts: Vec<(f64, f64)> = [1.0, 10.0, 100.0].iter().map(|&x| (x, 3.0 * x * x)).collect();
+        let pts: Vec<(f64, f64)> = [1.0, 10.0, 100.0]
+            .iter()
+            .map(|&x| (x, 3.0 * x * x))
+            .collect();
         let (slope, icpt) = loglog_fit(&pts).unwrap();
         assert!((slope - 2.0).abs() < 1e-12 && (icpt - 3f64.ln()).abs() < 1e-12);
         assert_eq!(loglog_fit(&[(1.0, 1.0)]), None);
