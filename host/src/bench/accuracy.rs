@@ -367,7 +367,9 @@ mod tests {
         assert_eq!((a.ties, a.false_hits, a.leaks, a.wrong_prim), (1, 1, 1, 0));
         // t = 6 against the plane of triangle 0 at 5: relative error 0.2.
         assert!((a.t_rel_max - 0.2).abs() < 1e-12);
-        let b = r.accuracy(&[hit(5.0, 0), hit(5.0, 0), HitRecord::MISS, hit(11.0, 0)]);
-        assert_eq!(b.wrong_prim, 1);
+        // Triangle 0 (z = 5) behind triangle 2 (z = 9) seen from z = 20: a different surface.
+        let b = r.accuracy(&[hit(5.0, 0), hit(5.0, 0), HitRecord::MISS, hit(15.0, 0)]);
+        assert_eq!((b.wrong_prim, b.ties), (1, 0));
+        assert!(b.t_rel_max < 1e-12);
     }
 }
