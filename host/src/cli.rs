@@ -41,6 +41,9 @@ pub enum Command {
     /// --scene and --rays, also check each differing ray passes within quantization error of an
     /// edge of a reported triangle.
     CompareHits(CompareArgs),
+    /// Benchmark speed and accuracy on the shared scenes, with peers in the same run; writes
+    /// BENCHMARKS.md, data.csv, data.json and plots/ into --out.
+    Bench(BenchArgs),
     /// Render a scene with the distribution ray tracer: a built-in scene (default `cornell`),
     /// a scene file (.json, see docs/SCENE_FORMAT.md) or an OBJ mesh; PNG out, optionally
     /// linear PFM; parallel over tiles.
@@ -318,6 +321,69 @@ pub struct CompareReport {
     pub classification: Option<Classification>,
 }
 
+/// `host bench [--quick] [--rays DIR | --rust-rays] [--out DIR] [options]`.
+#[derive(Clone, Debug, Args)]
+pub struct BenchArgs {
+    /// CI smoke test: every 64th ray, one run, scale sweep up to 100k triangles.
+    #[arg(long)]
+    pub quick: bool,
+    /// Directory of the scenes (NAME.obj, NAME.camera).
+    #[arg(long, value_name = "DIR", default_value = "../shared/scenes")]
+    pub scenes: PathBuf,
+    /// Scenes to run (repeatable).
+    #[arg(long = "scene", value_name = "NAME", default_values_t = ["bunny".to_string(), "sponza".to_string(), "kitchen".to_string()])]
+    pub scene_names: Vec<String>,
+    /// Ray files from `make_rays.py --out DIR` [default: run make_rays.py into a temp dir].
+    #[arg(long, value_name = "DIR", conflicts_with = "rust_rays")]
+    pub rays: Option<PathBuf>,
+    /// Generate the rays in Rust instead (primary by WORKLOAD.md's camera formula,
+    /// incoherent from SplitMix64: not the files' rays).
+    #[arg(long)]
+    pub rust_rays: bool,
+    /// Rays per set with --rust-rays.
+    #[arg(long, value_name = "N", default_value_t = 1 << 20,
+          value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
+    pub rays_per_set: usize,
+    /// Output directory.
+    #[arg(long, value_name = "DIR", default_value = "docs/bench")]
+    pub out: PathBuf,
+    /// Trace every K-th ray [default: 1, or 64 with --quick].
+    #[arg(long, value_name = "K", value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
+    pub stride: Option<usize>,
+    /// Runs per figure, medians [default: 3, or 1 with --quick].
+    #[arg(long, value_name = "N", value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
+    pub runs: Option<usize>,
+    /// Skip the peers.
+    #[arg(long)]
+    pub no_peers: bool,
+    /// Tiled-scene sizes in triangles, comma-separated; `0` skips the sweep
+    /// [default: 10k..2M, or 10k..100k with --quick].
+    #[arg(long, value_name = "N,N,...", value_delimiter = ',')]
+    pub scale: Option<Vec<usize>>,
+    /// Rays per set in the scale sweep [default: 262144, or 16384 with --quick].
+    #[arg(long, value_name = "N", value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
+    pub scale_rays: Option<usize>,
+}
+
+/// The JSON report of `host bench`: where the files went, and the run's size.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BenchReport {
+    /// The Markdown report.
+    pub report: String,
+    /// The CSV.
+    pub csv: String,
+    /// The JSON.
+    pub json: String,
+    /// PNG plots.
+    pub plots: Vec<String>,
+    /// Trace rows (ours and peers).
+    pub rows: usize,
+    /// Scale rows.
+    pub scale_rows: usize,
+    /// Wall time, seconds.
+    pub elapsed_s: f64,
+}
+
 /// The JSON report of `host trace`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TraceReport {
@@ -382,6 +448,7 @@ pub fn run(cli: &Cli) -> Result<String, Error> {
     let (summary, json) = match &cli.command {
         Command::Trace(args) => (None, serde_json::to_string(&run_trace(args)?)),
         Command::CompareHits(args) => (None, serde_json::to_string(&run_compare(args)?)),
+        Command::Bench(args) => (None, serde_json::to_string(&run_bench(args)?)),
         Command::Render(args) => {
             let report = run_render(args)?;
             (Some(report.summary()), serde_json::to_string(&report))
@@ -618,6 +685,62 @@ pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
         },
         depth: s.depth,
     })
+}
+
+/// `host bench`: run the benchmark, write the report, data and plots.
+///
+/// # Errors
+/// Missing inputs (the message says how to get them), bad scene or ray files, a build the
+/// kernel refuses, or an unwritable output directory.
+pub fn run_bench(args: &BenchArgs) -> Result<BenchReport, Error> {
+    use crate::bench::{scale::ScaleOptions, workload::RaySource, BenchConfig};
+    let rays = match (&args.rays, args.rust_rays) {
+        (Some(dir), _) => RaySource::Files(dir.clone()),
+        (None, true) => RaySource::Rust {
+            count: args.rays_per_set,
+        },
+        (None, false) => RaySource::MakeRays,
+    };
+    let sizes = match &args.scale {
+        Some(sizes) => sizes.iter().copied().filter(|&n| n > 0).collect(),
+        None => crate::bench::scale::default_sizes(args.quick),
+    };
+    let config = BenchConfig {
+        scenes_dir: args.scenes.clone(),
+        scenes: args.scene_names.clone(),
+        rays,
+        out: args.out.clone(),
+        stride: args.stride.unwrap_or(if args.quick { 64 } else { 1 }),
+        runs: args.runs.unwrap_or(if args.quick { 1 } else { 3 }),
+        peers: !args.no_peers,
+        scale: ScaleOptions {
+            sizes,
+            rays: args
+                .scale_rays
+                .unwrap_or(if args.quick { 1 << 14 } else { 1 << 18 }),
+            runs: args.runs.unwrap_or(if args.quick { 1 } else { 3 }),
+        },
+        quick: args.quick,
+        command: bench_command(),
+    };
+    let (results, written) = crate::bench::run(&config)?;
+    let show = |p: &Path| p.display().to_string();
+    Ok(BenchReport {
+        report: show(&written.report),
+        csv: show(&written.csv),
+        json: show(&written.json),
+        plots: written.plots.iter().map(|p| show(p)).collect(),
+        rows: results.rows.len(),
+        scale_rows: results.scale.len(),
+        elapsed_s: results.elapsed_s,
+    })
+}
+
+/// The command line as typed, with the program shown as `host`.
+fn bench_command() -> String {
+    let mut words: Vec<String> = std::env::args().skip(1).collect();
+    words.insert(0, "host".into());
+    words.join(" ")
 }
 
 /// `host compare-hits`: agreement of OTHER with REF.

@@ -136,6 +136,27 @@ impl PinholeCamera {
         norm(fwd) > 0.0 && norm(cross(fwd, self.up)) > 0.0
     }
 
+    /// The camera frame for a `width`×`height` image (aspect = width / height); `None` if the
+    /// camera is not [usable](Self::is_usable).
+    #[must_use]
+    pub fn view(&self, width: u32, height: u32) -> Option<View> {
+        if !self.is_usable() {
+            return None;
+        }
+        let fwd = normalize(sub(self.target, self.eye));
+        let right = normalize(cross(fwd, self.up));
+        Some(View {
+            fwd,
+            right,
+            up: cross(right, fwd),
+            eye: self.eye,
+            h: (self.vfov_deg.to_radians() / 2.0).tan(),
+            aspect: f64::from(width) / f64::from(height),
+            width,
+            height,
+        })
+    }
+
     /// The kernel's camera (pinhole).
     #[must_use]
     pub fn to_kernel(&self) -> Camera {
@@ -148,6 +169,33 @@ impl PinholeCamera {
             aperture_radius: 0.0,
             focus_distance: 1.0,
         }
+    }
+}
+
+/// A camera's frame for one image size: WORKLOAD.md's primary rays through pixel centres
+/// (the benchmark's ray sets; the renderer uses the kernel's own camera).
+#[derive(Clone, Copy, Debug)]
+pub struct View {
+    fwd: [f64; 3],
+    right: [f64; 3],
+    up: [f64; 3],
+    eye: [f64; 3],
+    h: f64,
+    aspect: f64,
+    width: u32,
+    height: u32,
+}
+
+impl View {
+    /// Origin and unit direction (rounded to `f32`) of the ray through the centre of pixel
+    /// (`px`, `py`), `py` = 0 at the top, with `u` scaled by the aspect ratio.
+    #[must_use]
+    pub fn ray(&self, px: u32, py: u32) -> ([f32; 3], [f32; 3]) {
+        let u = ((f64::from(px) + 0.5) / f64::from(self.width) * 2.0 - 1.0) * self.h * self.aspect;
+        let v = (1.0 - (f64::from(py) + 0.5) / f64::from(self.height) * 2.0) * self.h;
+        let d: [f64; 3] = std::array::from_fn(|k| self.fwd[k] + u * self.right[k] + v * self.up[k]);
+        let d = normalize(d);
+        (self.eye.map(|x| x as f32), d.map(|x| x as f32))
     }
 }
 

@@ -1,13 +1,19 @@
 //! Build an accelerator over a mesh and trace rays through it: the in-memory core of
-//! `host trace`, written once over the kernel's [`Scalar`] and dispatched on [`Mode`].
+//! `host trace` and `host bench`, written once over the kernel's [`Scalar`] and dispatched on
+//! [`Mode`].
+//!
+//! The pieces are public so the benchmark reuses them rather than copying the loop:
+//! [`build_and_visit`] builds whichever [`AccelKind`] is asked for (timed) and hands it to an
+//! [`AccelVisitor`]; [`prepare_rays`] and [`trace_closest`] are the timed halves of a trace.
+//! A new accelerator is a new [`AccelKind`] variant plus one arm in [`build_and_visit`].
 
 use crate::error::Error;
 use crate::obj::Mesh;
 use crate::rayfile::{HitRecord, RayRecord};
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::{
-    kdtree, Accel, Bvh, Grid, GridOptions, KdNode, KdOptions, KdTree, Linear, Node, Ray, Scalar,
-    Triangle, I16F16,
+    kdtree, Accel, Bvh, Grid, GridOptions, KdNode, KdOptions, KdTree, Linear, Node, Primitive, Ray,
+    Scalar, Triangle, I16F16,
 };
 use std::path::Path;
 use std::time::Instant;
@@ -26,6 +32,21 @@ pub enum AccelKind {
 }
 
 impl AccelKind {
+    /// Every accelerator, in command-line order. Benchmarks iterate over this list.
+    pub const ALL: [AccelKind; 4] = [Self::Bvh, Self::Linear, Self::Grid, Self::Kdtree];
+
+    /// True for brute force, the reference: too slow for whole benchmark ray sets.
+    #[must_use]
+    pub fn is_brute_force(self) -> bool {
+        matches!(self, Self::Linear)
+    }
+
+    /// True if the build takes a [`BuilderKind`] (otherwise the builder is ignored).
+    #[must_use]
+    pub fn uses_builder(self) -> bool {
+        matches!(self, Self::Bvh)
+    }
+
     /// Name as on the command line.
     #[must_use]
     pub fn name(self) -> &'static str {
@@ -48,6 +69,9 @@ pub enum Mode {
 }
 
 impl Mode {
+    /// Both modes.
+    pub const ALL: [Mode; 2] = [Self::F32, Self::Fixed];
+
     /// Name as on the command line (the kernel's `Scalar::NAME`).
     #[must_use]
     pub fn name(self) -> &'static str {
@@ -97,6 +121,51 @@ pub struct TraceConfig {
     pub leaf_order: bool,
 }
 
+impl TraceConfig {
+    /// The build part of the configuration.
+    #[must_use]
+    pub fn accel_config(&self) -> AccelConfig {
+        AccelConfig {
+            accel: self.accel,
+            build: self.build,
+            leaf_order: self.leaf_order,
+        }
+    }
+}
+
+/// What to build: accelerator, builder settings, leaf order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AccelConfig {
+    /// Accelerator.
+    pub accel: AccelKind,
+    /// Builder and leaf size (ignored unless [`AccelKind::uses_builder`]).
+    pub build: BuildOptions,
+    /// Permute the primitives into leaf order (BVH only).
+    pub leaf_order: bool,
+}
+
+/// Figures of one build.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BuildFigures {
+    /// Wall time of the build, including the leaf-order permutation (0 for brute force).
+    pub build_ms: f64,
+    /// Nodes in use (0 for brute force).
+    pub nodes: usize,
+    /// Bytes of nodes and primitive ids in use (0 for brute force).
+    pub accel_bytes: usize,
+    /// Depth of the deepest leaf (0 for brute force).
+    pub depth: u32,
+}
+
+/// Something to do with a freshly built accelerator (trace rays, count work...). A trait
+/// rather than a closure because it is generic over the accelerator type.
+pub trait AccelVisitor<S: Scalar> {
+    /// What the visit returns.
+    type Output;
+    /// Called once with the built accelerator.
+    fn visit<A: Accel<S>>(self, accel: &A) -> Self::Output;
+}
+
 /// Figures of a trace: times are the medians over the runs.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TraceStats {
@@ -119,11 +188,11 @@ pub struct TraceStats {
     pub hits: usize,
     /// Rays the kernel rejected (written as misses).
     pub bad_rays: usize,
-    /// BVH or kd-tree nodes in use, grid cells (0 for linear).
+    /// BVH nodes in use (0 for linear).
     pub nodes: usize,
-    /// Bytes of nodes (cell offsets) and primitive ids (references) in use (0 for linear).
+    /// Bytes of nodes and primitive ids in use (0 for linear).
     pub accel_bytes: usize,
-    /// Depth of the deepest leaf (0 for linear and the grid).
+    /// Depth of the deepest leaf (0 for linear).
     pub depth: u32,
 }
 
@@ -167,35 +236,13 @@ fn trace_in<S: Scalar>(
 ) -> Result<TraceOutput, Error> {
     assert!(config.runs > 0, "runs must be at least 1");
     let tris = mesh.kernel_triangles::<S>(scene)?;
-    let mut arena = match config.accel {
-        AccelKind::Bvh => NodeArena::<S>::new(nodes_needed(tris.len())),
-        _ => NodeArena::<S>::new(0),
-    };
-    // Grid and kd-tree memory, allocated once (untimed, like the BVH's arena); the grid's
-    // counting pass is repeated, timed, in every run, as a caller sizing memory would do.
-    let mut other = OtherArenas::<S>::default();
-    match config.accel {
-        AccelKind::Grid => {
-            let size =
-                Grid::size_for(&tris, GridOptions::default()).map_err(|source| Error::Build {
-                    scene: scene.to_path_buf(),
-                    source,
-                })?;
-            other.cells = vec![0; size.cells];
-            other.refs = vec![0; size.refs];
-        }
-        AccelKind::Kdtree => {
-            other.kd_nodes = vec![KdNode::EMPTY; kdtree::nodes_needed(tris.len())];
-            other.refs = vec![0; kdtree::refs_needed(tris.len())];
-        }
-        _ => {}
-    }
+    let mut arena = NodeArena::<S>::for_accel(config.accel, &tris);
     let mut first: Option<Vec<HitRecord>> = None;
     let mut last = None;
     let (mut build_ms_runs, mut trace_ms_runs) = (Vec::new(), Vec::new());
     let mut setup_ms_runs = Vec::new();
     for run in 0..config.runs {
-        let (hits, stats) = run_once(&tris, &mut arena, &mut other, scene, rays, config)?;
+        let (hits, stats) = run_once(&tris, &mut arena, scene, rays, config)?;
         if let Some(first) = &first {
             if let Some(ray) = first_difference(first, &hits) {
                 return Err(Error::RunsDiffer {
@@ -225,94 +272,119 @@ fn trace_in<S: Scalar>(
     Ok(TraceOutput { hits, stats })
 }
 
-/// One run: build (timed) and trace (timed).
+/// One run: build (timed) and trace (timed, rays prepared anew as part of the run).
 fn run_once<S: Scalar>(
     tris: &[Triangle<S>],
     arena: &mut NodeArena<S>,
-    other: &mut OtherArenas<S>,
     scene: &Path,
     rays: &[RayRecord],
     config: &TraceConfig,
 ) -> Result<(Vec<HitRecord>, TraceStats), Error> {
+    struct Closest<'r> {
+        rays: &'r [RayRecord],
+        stride: usize,
+    }
+    impl<S: Scalar> AccelVisitor<S> for Closest<'_> {
+        type Output = (Vec<HitRecord>, TraceStats);
+        fn visit<A: Accel<S>>(self, accel: &A) -> Self::Output {
+            trace_rays(accel, self.rays, self.stride)
+        }
+    }
+    let visitor = Closest {
+        rays,
+        stride: config.stride,
+    };
+    let (built, (hits, stats)) =
+        build_and_visit(tris, arena, scene, &config.accel_config(), visitor)?;
+    let stats = TraceStats {
+        build_ms: built.build_ms,
+        nodes: built.nodes,
+        accel_bytes: built.accel_bytes,
+        depth: built.depth,
+        ..stats
+    };
+    Ok((hits, stats))
+}
+
+/// Builds the accelerator `config` asks for over `prims` (timed, single-threaded) in `arena`
+/// and hands it to `visitor`. `arena` must come from [`NodeArena::for_accel`] with the same
+/// accelerator and primitive count. `scene` only labels errors.
+///
+/// # Errors
+/// [`Error::Build`] if the kernel refuses to build.
+pub fn build_and_visit<S: Scalar, P: Primitive<S> + Copy, V: AccelVisitor<S>>(
+    prims: &[P],
+    arena: &mut NodeArena<S>,
+    scene: &Path,
+    config: &AccelConfig,
+    visitor: V,
+) -> Result<(BuildFigures, V::Output), Error> {
     let build_error = |source| Error::Build {
         scene: scene.to_path_buf(),
         source,
     };
     match config.accel {
-        AccelKind::Linear => Ok(trace_rays(&Linear::new(tris), rays, config.stride)),
-        AccelKind::Grid => {
-            let options = GridOptions::default();
-            let start = Instant::now();
-            let size = Grid::size_for(tris, options).map_err(build_error)?;
-            let grid = Grid::build(tris, &mut other.cells, &mut other.refs, options)
-                .map_err(build_error)?;
-            let build_ms = millis(start);
-            debug_assert_eq!(grid.refs().len(), size.refs);
-            let (hits, stats) = trace_rays(&grid, rays, config.stride);
-            let stats = TraceStats {
-                build_ms,
-                nodes: grid.cells().len().saturating_sub(1),
-                accel_bytes: grid.bytes_used(),
-                ..stats
-            };
-            Ok((hits, stats))
-        }
-        AccelKind::Kdtree => {
-            let start = Instant::now();
-            let tree = KdTree::build(
-                tris,
-                &mut other.kd_nodes,
-                &mut other.refs,
-                KdOptions::default(),
-            )
-            .map_err(build_error)?;
-            let build_ms = millis(start);
-            let (hits, stats) = trace_rays(&tree, rays, config.stride);
-            let stats = TraceStats {
-                build_ms,
-                nodes: tree.nodes().len(),
-                accel_bytes: tree.bytes_used(),
-                depth: tree.depth(),
-                ..stats
-            };
-            Ok((hits, stats))
-        }
+        AccelKind::Linear => Ok((BuildFigures::default(), visitor.visit(&Linear::new(prims)))),
         AccelKind::Bvh if config.leaf_order => {
             // The permutation works in place: give it a fresh copy (untimed, like parsing).
-            let mut own = tris.to_vec();
-            let mut ids = vec![0u32; tris.len()];
+            let mut own = prims.to_vec();
+            let mut ids = vec![0u32; prims.len()];
             let start = Instant::now();
             let bvh = Bvh::build_in_leaf_order(&mut own, arena.slots(), &mut ids, config.build)
                 .map_err(build_error)?;
             let build_ms = millis(start);
-            Ok(traced_bvh(&bvh, build_ms, rays, config.stride))
+            Ok((bvh_figures(&bvh, build_ms), visitor.visit(&bvh)))
         }
         AccelKind::Bvh => {
-            let mut ids = vec![0u32; tris.len()];
+            let mut ids = vec![0u32; prims.len()];
             let start = Instant::now();
             let bvh =
-                Bvh::build(tris, arena.slots(), &mut ids, config.build).map_err(build_error)?;
+                Bvh::build(prims, arena.slots(), &mut ids, config.build).map_err(build_error)?;
             let build_ms = millis(start);
-            Ok(traced_bvh(&bvh, build_ms, rays, config.stride))
+            Ok((bvh_figures(&bvh, build_ms), visitor.visit(&bvh)))
+        }
+        AccelKind::Grid => {
+            // The counting pass is part of the timed build, as a caller sizing memory does it.
+            let options = GridOptions::default();
+            let start = Instant::now();
+            Grid::size_for(prims, options).map_err(build_error)?;
+            let grid = Grid::build(prims, &mut arena.words, &mut arena.refs, options)
+                .map_err(build_error)?;
+            let figures = BuildFigures {
+                build_ms: millis(start),
+                nodes: grid.cells().len().saturating_sub(1),
+                accel_bytes: grid.bytes_used(),
+                depth: 0,
+            };
+            Ok((figures, visitor.visit(&grid)))
+        }
+        AccelKind::Kdtree => {
+            let start = Instant::now();
+            let tree = KdTree::build(
+                prims,
+                &mut arena.kd_nodes,
+                &mut arena.refs,
+                KdOptions::default(),
+            )
+            .map_err(build_error)?;
+            let figures = BuildFigures {
+                build_ms: millis(start),
+                nodes: tree.nodes().len(),
+                accel_bytes: tree.bytes_used(),
+                depth: tree.depth(),
+            };
+            Ok((figures, visitor.visit(&tree)))
         }
     }
 }
 
-fn traced_bvh<S: Scalar>(
-    bvh: &Bvh<'_, S, Triangle<S>>,
-    build_ms: f64,
-    rays: &[RayRecord],
-    stride: usize,
-) -> (Vec<HitRecord>, TraceStats) {
-    let (hits, stats) = trace_rays(bvh, rays, stride);
-    let stats = TraceStats {
+fn bvh_figures<S: Scalar, P: Primitive<S>>(bvh: &Bvh<'_, S, P>, build_ms: f64) -> BuildFigures {
+    BuildFigures {
         build_ms,
         nodes: bvh.nodes().len(),
         accel_bytes: bvh.bytes_used(),
         depth: bvh.depth(),
-        ..stats
-    };
-    (hits, stats)
+    }
 }
 
 /// Index of the first record that differs bit for bit (or the shorter length), if any.
@@ -337,42 +409,57 @@ pub fn median(xs: &[f64]) -> f64 {
     }
 }
 
-/// Memory of the grid (cell offsets, references) and the kd-tree (nodes, references).
-struct OtherArenas<S: Scalar> {
-    cells: Vec<u32>,
+/// The memory an accelerator is built into, allocated once outside the timed builds. BVH
+/// nodes start on a 64-byte boundary, so that each sibling pair (two 32-byte nodes at an even
+/// slot) is one cache line, as the kernel's layout intends.
+pub struct NodeArena<S: Scalar> {
+    nodes: Vec<Node<S>>,
+    /// Grid cell offsets.
+    words: Vec<u32>,
+    /// Grid or kd-tree references.
     refs: Vec<u32>,
     kd_nodes: Vec<KdNode<S>>,
-}
-
-impl<S: Scalar> Default for OtherArenas<S> {
-    fn default() -> Self {
-        Self {
-            cells: Vec::new(),
-            refs: Vec::new(),
-            kd_nodes: Vec::new(),
-        }
-    }
-}
-
-/// A node arena whose first slot sits on a 64-byte boundary, so that each sibling pair (two
-/// 32-byte nodes at an even slot) is one cache line, as the kernel's layout intends.
-struct NodeArena<S: Scalar> {
-    nodes: Vec<Node<S>>,
 }
 
 impl<S: Scalar> NodeArena<S> {
     const LINE: usize = 64;
 
+    /// The memory `accel` needs over `prims` (empty for brute force, and for a grid the
+    /// counting pass rejects: its build reports the error).
+    #[must_use]
+    pub fn for_accel<P: Primitive<S>>(accel: AccelKind, prims: &[P]) -> Self {
+        let n = prims.len();
+        let mut arena = Self::new(0);
+        match accel {
+            AccelKind::Bvh => arena = Self::new(nodes_needed(n)),
+            AccelKind::Linear => {}
+            AccelKind::Grid => {
+                if let Ok(size) = Grid::size_for(prims, GridOptions::default()) {
+                    arena.words = vec![0; size.cells];
+                    arena.refs = vec![0; size.refs];
+                }
+            }
+            AccelKind::Kdtree => {
+                arena.kd_nodes = vec![KdNode::EMPTY; kdtree::nodes_needed(n)];
+                arena.refs = vec![0; kdtree::refs_needed(n)];
+            }
+        }
+        arena
+    }
+
     fn new(slots: usize) -> Self {
         // One spare slot: `Node` is 32-aligned, so skipping at most one reaches a 64-byte line.
         Self {
             nodes: vec![Node::EMPTY; slots + 1],
+            words: Vec::new(),
+            refs: Vec::new(),
+            kd_nodes: Vec::new(),
         }
     }
 
     /// The `slots` requested, starting on a 64-byte boundary.
     fn slots(&mut self) -> &mut [Node<S>] {
-        let misaligned = self.nodes.as_ptr() as usize % Self::LINE != 0;
+        let misaligned = !(self.nodes.as_ptr() as usize).is_multiple_of(Self::LINE);
         let skip = usize::from(misaligned);
         let len = self.nodes.len() - 1;
         &mut self.nodes[skip..skip + len]
@@ -385,6 +472,39 @@ fn trace_rays<S: Scalar, A: Accel<S>>(
     rays: &[RayRecord],
     stride: usize,
 ) -> (Vec<HitRecord>, TraceStats) {
+    let prepared = prepare_rays::<S>(rays, stride);
+    let (hits, trace_ms) = trace_closest(accel, &prepared);
+    let stats = TraceStats {
+        setup_ms: prepared.setup_ms,
+        trace_ms,
+        rays: hits.len(),
+        hits: hits.iter().filter(|h| h.is_hit()).count(),
+        bad_rays: prepared.bad.len(),
+        ..TraceStats::default()
+    };
+    (hits, stats)
+}
+
+/// Kernel rays made from ray-file records, one per traced record.
+///
+/// Invariant: `rays.len()` is the number of traced records; a record the kernel rejects holds
+/// a placeholder ray (valid in both modes) and its index is in `bad`, in increasing order.
+#[derive(Clone, Debug)]
+pub struct PreparedRays<S: Scalar> {
+    /// One kernel ray per traced record.
+    pub rays: Vec<Ray<S>>,
+    /// Indices (into `rays`) of the records the kernel rejected: traced as misses.
+    pub bad: Vec<usize>,
+    /// Wall time of the preparation (normalisation, reciprocals, shear constants).
+    pub setup_ms: f64,
+}
+
+/// Turns every `stride`-th record into a kernel ray (timed).
+///
+/// # Panics
+/// If `stride` is 0.
+#[must_use]
+pub fn prepare_rays<S: Scalar>(rays: &[RayRecord], stride: usize) -> PreparedRays<S> {
     assert!(stride > 0, "stride must be at least 1");
     let start = Instant::now();
     // Rejected records (bad rays) are traced as a placeholder and written as misses. The
@@ -403,11 +523,23 @@ fn trace_rays<S: Scalar, A: Accel<S>>(
             }
         }
     }
-    let setup_ms = millis(start);
-    let bad_rays = bad.len();
-    let mut hits = vec![HitRecord::MISS; prepared.len()];
+    PreparedRays {
+        rays: prepared,
+        bad,
+        setup_ms: millis(start),
+    }
+}
+
+/// Closest hit of every prepared ray, stored as hit records (misses for rejected records),
+/// and the wall time of tracing and storing them in milliseconds.
+#[must_use]
+pub fn trace_closest<S: Scalar, A: Accel<S>>(
+    accel: &A,
+    prepared: &PreparedRays<S>,
+) -> (Vec<HitRecord>, f64) {
+    let mut hits = vec![HitRecord::MISS; prepared.rays.len()];
     let start = Instant::now();
-    for (slot, ray) in hits.iter_mut().zip(&prepared) {
+    for (slot, ray) in hits.iter_mut().zip(&prepared.rays) {
         if let Some(h) = accel.intersect(ray) {
             *slot = HitRecord {
                 t: h.t.to_f32(),
@@ -415,22 +547,15 @@ fn trace_rays<S: Scalar, A: Accel<S>>(
             };
         }
     }
-    for &i in &bad {
+    for &i in &prepared.bad {
         hits[i] = HitRecord::MISS;
     }
-    let trace_ms = millis(start);
-    let stats = TraceStats {
-        setup_ms,
-        trace_ms,
-        rays: hits.len(),
-        hits: hits.iter().filter(|h| h.is_hit()).count(),
-        bad_rays,
-        ..TraceStats::default()
-    };
-    (hits, stats)
+    (hits, millis(start))
 }
 
-fn millis(start: Instant) -> f64 {
+/// Milliseconds since `start`.
+#[must_use]
+pub fn millis(start: Instant) -> f64 {
     start.elapsed().as_secs_f64() * 1e3
 }
 

@@ -1,0 +1,151 @@
+//! `host bench`: speed and accuracy in one run, with peers, on the shared scenes.
+//!
+//! - [`workload`]: scenes and the WORKLOAD.md ray sets (files from `make_rays.py`, or generated),
+//! - [`ours`]: the kernel's contenders (every accelerator, builder and mode, plus the
+//!   benchmark-only Möller–Trumbore contrast of [`mt`]),
+//! - [`peers`]: `obvhs` (BVH2, CWBVH) and `bvh`, measured in the same run,
+//! - [`accuracy`]: the `f64` reference and each contender's hit-distance error,
+//! - [`scale`]: the tiled scene from 10k to 1M+ triangles,
+//! - [`report`], [`plot`], [`stats`]: Markdown, CSV, JSON and PNG output,
+//! - [`machine`]: the machine line.
+//!
+//! Everything is single-threaded except the untimed `f64` reference.
+
+pub mod accuracy;
+pub mod machine;
+pub mod mt;
+pub mod ours;
+pub mod peers;
+pub mod plot;
+pub mod report;
+pub mod results;
+pub mod scale;
+pub mod stats;
+pub mod workload;
+
+use crate::compare::{compare_hits, DEFAULT_REL};
+use crate::error::Error;
+use report::{BenchResults, ReferenceRow, Written};
+use std::path::PathBuf;
+use std::time::Instant;
+use workload::RaySource;
+
+/// What to run.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BenchConfig {
+    /// Directory of `NAME.obj` and `NAME.camera`.
+    pub scenes_dir: PathBuf,
+    /// Scene names.
+    pub scenes: Vec<String>,
+    /// Where the rays come from.
+    pub rays: RaySource,
+    /// Output directory: `BENCHMARKS.md`, `data.csv`, `data.json`, `plots/`.
+    pub out: PathBuf,
+    /// Trace every `stride`-th ray.
+    pub stride: usize,
+    /// Runs per figure (medians).
+    pub runs: usize,
+    /// Measure the peers too.
+    pub peers: bool,
+    /// The tiled-scene sweep (empty sizes: skipped).
+    pub scale: scale::ScaleOptions,
+    /// `--quick` (noted in the report).
+    pub quick: bool,
+    /// The command line, for the report.
+    pub command: String,
+}
+
+/// Runs the benchmark and writes the report, data and plots.
+///
+/// # Errors
+/// Missing inputs ([`Error::Bench`] says what and how to get them), unreadable scenes or ray
+/// files, a build the kernel refuses, or an unwritable output.
+pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
+    let start = Instant::now();
+    let mut machine = machine::Machine::probe();
+    let stride = config.stride.max(1);
+    let runs = config.runs.max(1);
+    let opts = ours::RunOptions { stride, runs };
+    eprintln!("bench: {}", machine.line());
+    let scenes = workload::load_scenes(&config.scenes_dir, &config.scenes, &config.rays)?;
+    let threads = machine.cores.max(1);
+    let mut rows = Vec::new();
+    let mut references = Vec::new();
+    for scene in &scenes {
+        let tris: Vec<[[f32; 3]; 3]> = (0..scene.mesh.triangle_count())
+            .map(|i| scene.mesh.triangle_f32(i))
+            .collect();
+        for set in &scene.ray_sets {
+            eprintln!(
+                "bench: {} {} ({} rays, stride {stride})",
+                scene.name,
+                set.kind.name(),
+                set.records.len()
+            );
+            let mut set_rows = ours::run(scene, set, opts)?;
+            if config.peers {
+                for peer in peers::Peer::ALL {
+                    eprintln!("bench:   {}", peer.name());
+                    set_rows.push(peers::run(peer, scene, set, opts));
+                }
+            }
+            let reference = accuracy::Reference::compute(&tris, &set.records, stride, threads)
+                .map_err(|source| Error::Build {
+                    scene: scene.path.clone(),
+                    source,
+                })?;
+            references.push(ReferenceRow {
+                scene: scene.name.clone(),
+                rays: set.kind,
+                ray_count: reference.len(),
+                hits: reference.hit_count(),
+            });
+            let ours_hits = set_rows
+                .first()
+                .filter(|r| r.ours)
+                .map(|r| r.hit_records.clone())
+                .unwrap_or_default();
+            for row in &mut set_rows {
+                row.accuracy = Some(reference.accuracy(&row.hit_records));
+                if !row.ours {
+                    row.vs_ours = Some(compare_hits(&ours_hits, &row.hit_records, DEFAULT_REL));
+                }
+                // The hits have served; a full run would otherwise keep ~100 MB per set.
+                row.hit_records = Vec::new();
+            }
+            rows.extend(set_rows);
+        }
+    }
+    let scale_rows = if config.scale.sizes.is_empty() {
+        Vec::new()
+    } else {
+        let meshes: Vec<&crate::obj::Mesh> = scenes.iter().map(|s| &s.mesh).collect();
+        scale::run(&meshes, &config.scale)?
+    };
+    machine.load_end = machine::load_average();
+    let mut results = BenchResults {
+        machine,
+        command: config.command.clone(),
+        quick: config.quick,
+        stride,
+        runs,
+        ray_source: match &config.rays {
+            RaySource::Files(dir) => format!("ray files from make_rays.py in {}", dir.display()),
+            RaySource::MakeRays => "ray files written by make_rays.py for this run".into(),
+            RaySource::Rust { count } => format!(
+                "{count} rays per set generated in Rust (primary: WORKLOAD.md's camera; \
+                 incoherent: SplitMix64, not the files' PCG64 rays)"
+            ),
+        },
+        rows,
+        reference: references,
+        scale: scale_rows,
+        slopes: Vec::new(),
+        elapsed_s: 0.0,
+    };
+    std::fs::create_dir_all(&config.out)
+        .map_err(|e| Error::Bench(format!("cannot create {}: {e}", config.out.display())))?;
+    results.elapsed_s = start.elapsed().as_secs_f64();
+    let written = report::write_all(&mut results, &config.out)?;
+    Ok((results, written))
+}

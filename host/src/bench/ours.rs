@@ -1,0 +1,273 @@
+//! Our kernel's contenders: every accelerator of [`AccelKind::ALL`] (brute force excepted),
+//! every builder it takes, in `f32` (watertight, and Möller–Trumbore as a contrast on SAH) and
+//! fixed point. The build and the trace go through [`crate::trace`]'s shared functions.
+
+use super::mt::MtTriangle;
+use super::results::TraceRow;
+use super::workload::{BenchScene, RaySet};
+use crate::error::Error;
+use crate::rayfile::HitRecord;
+use crate::trace::{
+    build_and_visit, median, millis, prepare_rays, trace_closest, AccelConfig, AccelKind,
+    AccelVisitor, BuildFigures, Mode, NodeArena, PreparedRays,
+};
+use raykernel::bvh::{BuildOptions, BuilderKind};
+use raykernel::{Accel, Primitive, Scalar, TraversalStats, Triangle, I16F16};
+use std::hint::black_box;
+use std::path::Path;
+use std::time::Instant;
+
+/// The `test` label of the Möller–Trumbore contrast rows.
+pub const MT_TEST: &str = "Möller–Trumbore";
+
+/// Repetitions and ray subset.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RunOptions {
+    /// Trace rays `0, stride, 2·stride, ...`.
+    pub stride: usize,
+    /// Full runs (build + trace); figures are medians.
+    pub runs: usize,
+}
+
+/// One configuration of ours.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OurConfig {
+    /// Accelerator and builder.
+    pub accel: AccelConfig,
+    /// Number mode.
+    pub mode: Mode,
+    /// Möller–Trumbore instead of the watertight test (`f32` only).
+    pub mt: bool,
+}
+
+/// Every configuration measured: for each non-brute-force accelerator and each builder it
+/// takes, `f32` and fixed point; plus `f32` Möller–Trumbore on the default BVH builder.
+#[must_use]
+pub fn configs() -> Vec<OurConfig> {
+    let mut out = Vec::new();
+    for accel in AccelKind::ALL {
+        if accel.is_brute_force() {
+            continue;
+        }
+        let builders: Vec<BuilderKind> = if accel.uses_builder() {
+            BuilderKind::ALL.to_vec()
+        } else {
+            vec![BuilderKind::default()]
+        };
+        for builder in builders {
+            let accel = AccelConfig {
+                accel,
+                build: BuildOptions {
+                    builder,
+                    ..BuildOptions::default()
+                },
+                leaf_order: false,
+            };
+            for mode in Mode::ALL {
+                out.push(OurConfig {
+                    accel,
+                    mode,
+                    mt: false,
+                });
+            }
+            if accel.accel == AccelKind::Bvh && builder == BuilderKind::default() {
+                out.push(OurConfig {
+                    accel,
+                    mode: Mode::F32,
+                    mt: true,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// Runs every configuration of [`configs`] on one ray set. The first row is the reference
+/// the peers are compared with: `f32`, watertight, on the first builder of the first
+/// accelerator (SAH BVH).
+///
+/// # Errors
+/// A scene the mode cannot represent, or a build the kernel refuses.
+pub fn run(scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Result<Vec<TraceRow>, Error> {
+    let tris32 = scene.mesh.kernel_triangles::<f32>(&scene.path)?;
+    let mt: Vec<MtTriangle> = tris32.iter().copied().map(MtTriangle).collect();
+    let prepared32 = prepare_rays::<f32>(&set.records, opts.stride);
+    // Fixed point may not represent the scene (coordinates beyond ±8192): then no fixed rows.
+    let tris_fixed: Option<Vec<Triangle<I16F16>>> =
+        scene.mesh.kernel_triangles::<I16F16>(&scene.path).ok();
+    let prepared_fixed = tris_fixed
+        .as_ref()
+        .map(|_| prepare_rays::<I16F16>(&set.records, opts.stride));
+    let mut rows = Vec::new();
+    for config in configs() {
+        let measured = match (config.mode, config.mt, &tris_fixed, &prepared_fixed) {
+            (Mode::F32, false, _, _) => {
+                measure(&tris32, &prepared32, &scene.path, &config.accel, opts.runs)?
+            }
+            (Mode::F32, true, _, _) => {
+                measure(&mt, &prepared32, &scene.path, &config.accel, opts.runs)?
+            }
+            (Mode::Fixed, _, Some(tris), Some(prepared)) => {
+                measure(tris, prepared, &scene.path, &config.accel, opts.runs)?
+            }
+            (Mode::Fixed, _, _, _) => continue,
+        };
+        let setup_ms = match config.mode {
+            Mode::F32 => prepared32.setup_ms,
+            Mode::Fixed => prepared_fixed.as_ref().map_or(0.0, |p| p.setup_ms),
+        };
+        let n = measured.hits.len();
+        let per_ray = |x: u64| if n > 0 { x as f64 / n as f64 } else { 0.0 };
+        rows.push(TraceRow {
+            scene: scene.name.clone(),
+            rays: set.kind,
+            ray_count: n,
+            triangles: tris32.len(),
+            ours: true,
+            contender: format!("raykernel {}", config.accel.accel.name()),
+            builder: if config.accel.accel.uses_builder() {
+                config.accel.build.builder.name().into()
+            } else {
+                "-".into()
+            },
+            test: if config.mt {
+                MT_TEST.into()
+            } else if config.mode == Mode::Fixed {
+                "exact integer".into()
+            } else {
+                "watertight".into()
+            },
+            mode: config.mode.name().into(),
+            build_ms: measured.build_ms,
+            setup_ms,
+            closest_mrays: mrays(n, measured.closest_ms),
+            any_mrays: mrays(n, measured.any_ms),
+            nodes_per_ray: Some(per_ray(measured.counted.nodes_visited)),
+            prims_per_ray: Some(per_ray(measured.counted.prims_tested)),
+            bytes_per_tri: if tris32.is_empty() {
+                0.0
+            } else {
+                measured.figures.accel_bytes as f64 / tris32.len() as f64
+            },
+            depth: Some(measured.figures.depth),
+            hits: measured.hits.iter().filter(|h| h.is_hit()).count(),
+            any_hits: measured.any_hits,
+            vs_ours: None,
+            accuracy: None,
+            hit_records: measured.hits,
+        });
+    }
+    Ok(rows)
+}
+
+/// Million rays per second.
+#[must_use]
+pub fn mrays(rays: usize, ms: f64) -> f64 {
+    if ms > 0.0 {
+        rays as f64 / ms / 1e3
+    } else {
+        0.0
+    }
+}
+
+/// Medians over the runs, and the last run's hits and counters.
+pub(crate) struct Measured {
+    pub(crate) build_ms: f64,
+    pub(crate) closest_ms: f64,
+    pub(crate) any_ms: f64,
+    pub(crate) hits: Vec<HitRecord>,
+    pub(crate) any_hits: usize,
+    pub(crate) counted: TraversalStats,
+    pub(crate) figures: BuildFigures,
+}
+
+/// `runs` full runs of build + closest-hit trace; the last run also times any hit once and
+/// counts nodes and primitives in one more closest-hit pass (untimed).
+pub(crate) fn measure<S: Scalar, P: Primitive<S> + Copy>(
+    prims: &[P],
+    prepared: &PreparedRays<S>,
+    scene: &Path,
+    config: &AccelConfig,
+    runs: usize,
+) -> Result<Measured, Error> {
+    let runs = runs.max(1);
+    let mut arena = NodeArena::<S>::for_accel(config.accel, prims);
+    let (mut builds, mut closest) = (Vec::new(), Vec::new());
+    let mut last = None;
+    for run in 0..runs {
+        // Any hit is timed once, on the last run (closest hit carries the protocol's medians).
+        let extras = (run + 1 == runs).then_some(1);
+        let pass = Pass { prepared, extras };
+        let (figures, out) = build_and_visit(prims, &mut arena, scene, config, pass)?;
+        builds.push(figures.build_ms);
+        closest.push(out.closest_ms);
+        last = Some((figures, out));
+    }
+    let Some((figures, out)) = last else {
+        return Err(Error::Bench("no run".into()));
+    };
+    Ok(Measured {
+        build_ms: median(&builds),
+        closest_ms: median(&closest),
+        any_ms: median(&out.any_ms),
+        hits: out.hits,
+        any_hits: out.any_hits,
+        counted: out.counted,
+        figures,
+    })
+}
+
+/// One pass over a built accelerator: closest hit (timed); with `extras = Some(k)`, also any
+/// hit timed `k` times and a counted closest-hit pass.
+struct Pass<'p, S: Scalar> {
+    prepared: &'p PreparedRays<S>,
+    extras: Option<usize>,
+}
+
+struct PassOut {
+    hits: Vec<HitRecord>,
+    closest_ms: f64,
+    any_ms: Vec<f64>,
+    any_hits: usize,
+    counted: TraversalStats,
+}
+
+impl<S: Scalar> AccelVisitor<S> for Pass<'_, S> {
+    type Output = PassOut;
+
+    fn visit<A: Accel<S>>(self, accel: &A) -> PassOut {
+        let (hits, closest_ms) = trace_closest(accel, self.prepared);
+        let mut out = PassOut {
+            hits,
+            closest_ms,
+            any_ms: Vec::new(),
+            any_hits: 0,
+            counted: TraversalStats::default(),
+        };
+        let Some(any_runs) = self.extras else {
+            return out;
+        };
+        let rays = &self.prepared.rays;
+        for _ in 0..any_runs {
+            let start = Instant::now();
+            let mut occluded = 0usize;
+            for ray in rays {
+                occluded += usize::from(accel.occluded(ray));
+            }
+            out.any_ms.push(millis(start));
+            out.any_hits = black_box(occluded);
+        }
+        // Rejected records are placeholders (empty interval): remove any count they made.
+        for &i in &self.prepared.bad {
+            if rays.get(i).is_some_and(|r| accel.occluded(r)) {
+                out.any_hits -= 1;
+            }
+        }
+        let mut counted = TraversalStats::default();
+        for ray in rays {
+            black_box(accel.intersect_counted(ray, &mut counted));
+        }
+        out.counted = counted;
+        out
+    }
+}

@@ -1,0 +1,439 @@
+//! Peers measured in the same run, on the same triangles and rays: `obvhs` 0.4 (BVH2 and
+//! CWBVH, its own two-sided Möller–Trumbore test) and `bvh` 0.13 (svenstaro; its triangle test
+//! culls back faces, so it traces with this benchmark's two-sided Möller–Trumbore from
+//! [`super::mt`], as the workload's triangles are two-sided).
+//!
+//! Each peer is used as its documentation shows, single-threaded (no rayon features): build
+//! from the triangle list, then one query per ray. Times and figures follow our rows: build
+//! wall time of the library call, rays converted to the peer's ray type before timing, medians
+//! over the runs.
+
+use super::mt::moller_trumbore;
+use super::ours::{mrays, RunOptions};
+use super::results::TraceRow;
+use super::workload::{BenchScene, RaySet};
+use crate::rayfile::HitRecord;
+use crate::trace::{median, millis};
+use glam_peer::Vec3A;
+use std::cell::Cell;
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+/// The peers, in report order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Peer {
+    /// `obvhs` BVH2: PLOC build (`medium_build` preset) with reinsertion and leaf collapse.
+    ObvhsBvh2,
+    /// `obvhs` CWBVH: the same PLOC BVH2 compressed to 8-wide nodes (Ylitie et al. 2017).
+    ObvhsCwbvh,
+    /// `bvh` (svenstaro): binned SAH BVH2.
+    SvenstaroBvh,
+}
+
+impl Peer {
+    /// Every peer.
+    pub const ALL: [Peer; 3] = [Self::ObvhsBvh2, Self::ObvhsCwbvh, Self::SvenstaroBvh];
+
+    /// Name in the report.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::ObvhsBvh2 => "obvhs 0.4 BVH2",
+            Self::ObvhsCwbvh => "obvhs 0.4 CWBVH",
+            Self::SvenstaroBvh => "bvh 0.13",
+        }
+    }
+
+    fn builder(self) -> &'static str {
+        match self {
+            Self::ObvhsBvh2 | Self::ObvhsCwbvh => "PLOC medium",
+            Self::SvenstaroBvh => "binned SAH",
+        }
+    }
+
+    fn test(self) -> &'static str {
+        match self {
+            Self::ObvhsBvh2 | Self::ObvhsCwbvh => "Möller–Trumbore (obvhs)",
+            Self::SvenstaroBvh => "Möller–Trumbore (bench)",
+        }
+    }
+}
+
+/// Figures of one peer run (medians over the runs).
+struct PeerMeasured {
+    build_ms: f64,
+    setup_ms: f64,
+    closest_ms: f64,
+    any_ms: f64,
+    hits: Vec<HitRecord>,
+    any_hits: usize,
+    prims_tested: u64,
+    bytes: usize,
+}
+
+/// Runs one peer on one ray set.
+#[must_use]
+pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> TraceRow {
+    let tris: Vec<[[f32; 3]; 3]> = (0..scene.mesh.triangle_count())
+        .map(|i| scene.mesh.triangle_f32(i))
+        .collect();
+    let records: Vec<_> = set.records.iter().step_by(opts.stride.max(1)).collect();
+    let runs = opts.runs.max(1);
+    let m = match peer {
+        Peer::ObvhsBvh2 | Peer::ObvhsCwbvh => obvhs_run(peer, &tris, &records, runs),
+        Peer::SvenstaroBvh => svenstaro_run(&tris, &records, runs),
+    };
+    let n = m.hits.len();
+    TraceRow {
+        scene: scene.name.clone(),
+        rays: set.kind,
+        ray_count: n,
+        triangles: tris.len(),
+        ours: false,
+        contender: peer.name().into(),
+        builder: peer.builder().into(),
+        test: peer.test().into(),
+        mode: "f32".into(),
+        build_ms: m.build_ms,
+        setup_ms: m.setup_ms,
+        closest_mrays: mrays(n, m.closest_ms),
+        any_mrays: mrays(n, m.any_ms),
+        nodes_per_ray: None,
+        prims_per_ray: Some(if n > 0 {
+            m.prims_tested as f64 / n as f64
+        } else {
+            0.0
+        }),
+        bytes_per_tri: if tris.is_empty() {
+            0.0
+        } else {
+            m.bytes as f64 / tris.len() as f64
+        },
+        depth: None,
+        hits: m.hits.iter().filter(|h| h.is_hit()).count(),
+        any_hits: m.any_hits,
+        vs_ours: None,
+        accuracy: None,
+        hit_records: m.hits,
+    }
+}
+
+/// The two obvhs structures share this query surface.
+trait ObvhsQueries {
+    fn closest<F: FnMut(&obvhs::ray::Ray, usize) -> f32>(
+        &self,
+        ray: obvhs::ray::Ray,
+        hit: &mut obvhs::ray::RayHit,
+        f: F,
+    ) -> bool;
+    fn miss<F: FnMut(&obvhs::ray::Ray, usize) -> f32>(&self, ray: obvhs::ray::Ray, f: F) -> bool;
+    fn ids(&self) -> &[u32];
+    fn bytes(&self) -> usize;
+}
+
+impl ObvhsQueries for obvhs::bvh2::Bvh2 {
+    fn closest<F: FnMut(&obvhs::ray::Ray, usize) -> f32>(
+        &self,
+        ray: obvhs::ray::Ray,
+        hit: &mut obvhs::ray::RayHit,
+        f: F,
+    ) -> bool {
+        self.ray_traverse(ray, hit, f)
+    }
+    fn miss<F: FnMut(&obvhs::ray::Ray, usize) -> f32>(&self, ray: obvhs::ray::Ray, f: F) -> bool {
+        self.ray_traverse_miss(ray, f)
+    }
+    fn ids(&self) -> &[u32] {
+        &self.primitive_indices
+    }
+    fn bytes(&self) -> usize {
+        std::mem::size_of_val(&self.nodes[..]) + std::mem::size_of_val(&self.primitive_indices[..])
+    }
+}
+
+impl ObvhsQueries for obvhs::cwbvh::CwBvh {
+    fn closest<F: FnMut(&obvhs::ray::Ray, usize) -> f32>(
+        &self,
+        ray: obvhs::ray::Ray,
+        hit: &mut obvhs::ray::RayHit,
+        f: F,
+    ) -> bool {
+        self.ray_traverse(ray, hit, f)
+    }
+    fn miss<F: FnMut(&obvhs::ray::Ray, usize) -> f32>(&self, ray: obvhs::ray::Ray, f: F) -> bool {
+        self.ray_traverse_miss(ray, f)
+    }
+    fn ids(&self) -> &[u32] {
+        &self.primitive_indices
+    }
+    fn bytes(&self) -> usize {
+        std::mem::size_of_val(&self.nodes[..]) + std::mem::size_of_val(&self.primitive_indices[..])
+    }
+}
+
+fn obvhs_run(
+    peer: Peer,
+    tris: &[[[f32; 3]; 3]],
+    records: &[&crate::rayfile::RayRecord],
+    runs: usize,
+) -> PeerMeasured {
+    let v = |p: [f32; 3]| Vec3A::new(p[0], p[1], p[2]);
+    let otris: Vec<obvhs::triangle::Triangle> = tris
+        .iter()
+        .map(|t| obvhs::triangle::Triangle {
+            v0: v(t[0]),
+            v1: v(t[1]),
+            v2: v(t[2]),
+        })
+        .collect();
+    let start = Instant::now();
+    let rays: Vec<obvhs::ray::Ray> = records
+        .iter()
+        .map(|r| obvhs::ray::Ray::new(v(r.origin), v(r.dir), r.t_min, r.t_max))
+        .collect();
+    let setup_ms = millis(start);
+    let params = obvhs::BvhBuildParams::medium_build();
+    let mut builds = Vec::new();
+    let mut out = None;
+    for _ in 0..runs {
+        let mut core = Duration::default();
+        let start = Instant::now();
+        match peer {
+            Peer::ObvhsCwbvh => {
+                let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(&otris, params, &mut core);
+                builds.push(millis(start));
+                out = Some(obvhs_queries(&bvh, &otris, &rays, runs));
+            }
+            _ => {
+                let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(&otris, params, &mut core);
+                builds.push(millis(start));
+                out = Some(obvhs_queries(&bvh, &otris, &rays, runs));
+            }
+        }
+    }
+    let (mut m, closest) = out.unwrap_or_else(|| (empty_measured(), Vec::new()));
+    m.build_ms = median(&builds);
+    m.setup_ms = setup_ms;
+    m.closest_ms = median(&closest);
+    m
+}
+
+fn empty_measured() -> PeerMeasured {
+    PeerMeasured {
+        build_ms: 0.0,
+        setup_ms: 0.0,
+        closest_ms: 0.0,
+        any_ms: 0.0,
+        hits: Vec::new(),
+        any_hits: 0,
+        prims_tested: 0,
+        bytes: 0,
+    }
+}
+
+/// Closest hit `runs` times, any hit once, one counted closest pass.
+fn obvhs_queries<B: ObvhsQueries>(
+    bvh: &B,
+    tris: &[obvhs::triangle::Triangle],
+    rays: &[obvhs::ray::Ray],
+    runs: usize,
+) -> (PeerMeasured, Vec<f64>) {
+    let ids = bvh.ids();
+    let tri = |id: usize| ids.get(id).and_then(|&p| tris.get(p as usize));
+    let test = |r: &obvhs::ray::Ray, id: usize| tri(id).map_or(f32::INFINITY, |t| t.intersect(r));
+    let mut closest = Vec::new();
+    let mut hits = vec![HitRecord::MISS; rays.len()];
+    for _ in 0..runs {
+        let start = Instant::now();
+        for (slot, ray) in hits.iter_mut().zip(rays) {
+            let mut hit = obvhs::ray::RayHit::none();
+            if bvh.closest(*ray, &mut hit, test) {
+                *slot = HitRecord {
+                    t: hit.t,
+                    prim: ids
+                        .get(hit.primitive_id as usize)
+                        .copied()
+                        .unwrap_or(u32::MAX),
+                };
+            }
+        }
+        closest.push(millis(start));
+    }
+    // Any hit timed once, as for ours.
+    let mut any = Vec::new();
+    let any_hits;
+    {
+        let start = Instant::now();
+        let mut n = 0usize;
+        for ray in rays {
+            n += usize::from(!bvh.miss(*ray, test));
+        }
+        any.push(millis(start));
+        any_hits = black_box(n);
+    }
+    let tested = Cell::new(0u64);
+    for ray in rays {
+        let mut hit = obvhs::ray::RayHit::none();
+        black_box(bvh.closest(*ray, &mut hit, |r, id| {
+            tested.set(tested.get() + 1);
+            test(r, id)
+        }));
+    }
+    let m = PeerMeasured {
+        any_ms: median(&any),
+        hits,
+        any_hits,
+        prims_tested: tested.get(),
+        bytes: bvh.bytes(),
+        ..empty_measured()
+    };
+    (m, closest)
+}
+
+/// A triangle as the `bvh` crate wants it: bounds, and the node index it writes back.
+struct SvenTri {
+    v: [[f32; 3]; 3],
+    id: u32,
+    node: usize,
+}
+
+impl bvh::aabb::Bounded<f32, 3> for SvenTri {
+    fn aabb(&self) -> bvh::aabb::Aabb<f32, 3> {
+        let [a, b, c] = self.v;
+        let lo = nalgebra::Point3::new(
+            a[0].min(b[0]).min(c[0]),
+            a[1].min(b[1]).min(c[1]),
+            a[2].min(b[2]).min(c[2]),
+        );
+        let hi = nalgebra::Point3::new(
+            a[0].max(b[0]).max(c[0]),
+            a[1].max(b[1]).max(c[1]),
+            a[2].max(b[2]).max(c[2]),
+        );
+        bvh::aabb::Aabb::with_bounds(lo, hi)
+    }
+}
+
+impl bvh::bounding_hierarchy::BHShape<f32, 3> for SvenTri {
+    fn set_bh_node_index(&mut self, index: usize) {
+        self.node = index;
+    }
+    fn bh_node_index(&self) -> usize {
+        self.node
+    }
+}
+
+/// One ray for the `bvh` crate, with the record's fields for the triangle test.
+struct SvenRay {
+    ray: bvh::ray::Ray<f32, 3>,
+    o: [f32; 3],
+    d: [f32; 3],
+    t_min: f32,
+    t_max: f32,
+}
+
+/// Closest hit through `nearest_traverse_iterator` (shapes in order of box entry), stopping
+/// at the first box entered beyond the best hit; ties to the lower id, as ours.
+fn sven_closest(
+    bvh: &bvh::bvh::Bvh<f32, 3>,
+    shapes: &[SvenTri],
+    r: &SvenRay,
+    count: &mut u64,
+) -> HitRecord {
+    use bvh::aabb::Bounded;
+    let mut best = HitRecord::MISS;
+    for s in bvh.nearest_traverse_iterator(&r.ray, shapes) {
+        if best.is_hit() {
+            match r.ray.intersection_slice_for_aabb(&s.aabb()) {
+                Some((entry, _)) if entry > best.t => break,
+                _ => {}
+            }
+        }
+        *count += 1;
+        let t_max = if best.is_hit() { best.t } else { r.t_max };
+        if let Some((t, _, _)) = moller_trumbore(&s.v, r.o, r.d, r.t_min, t_max) {
+            if !best.is_hit() || t < best.t || (t == best.t && s.id < best.prim) {
+                best = HitRecord { t, prim: s.id };
+            }
+        }
+    }
+    best
+}
+
+fn svenstaro_run(
+    tris: &[[[f32; 3]; 3]],
+    records: &[&crate::rayfile::RayRecord],
+    runs: usize,
+) -> PeerMeasured {
+    let start = Instant::now();
+    let rays: Vec<SvenRay> = records
+        .iter()
+        .map(|r| SvenRay {
+            ray: bvh::ray::Ray::new(
+                nalgebra::Point3::from(r.origin),
+                nalgebra::Vector3::from(r.dir),
+            ),
+            o: r.origin,
+            d: r.dir,
+            t_min: r.t_min,
+            t_max: r.t_max,
+        })
+        .collect();
+    let setup_ms = millis(start);
+    let mut builds = Vec::new();
+    let mut closest = Vec::new();
+    let mut hits = vec![HitRecord::MISS; rays.len()];
+    let mut shapes = Vec::new();
+    let mut tree = None;
+    let mut tested = 0u64;
+    for _ in 0..runs {
+        shapes = tris
+            .iter()
+            .enumerate()
+            .map(|(i, t)| SvenTri {
+                v: *t,
+                id: i as u32,
+                node: 0,
+            })
+            .collect();
+        let start = Instant::now();
+        let bvh = bvh::bvh::Bvh::build(&mut shapes);
+        builds.push(millis(start));
+        let start = Instant::now();
+        // Counting the tests is one increment per test, negligible beside the test itself.
+        let mut count = 0u64;
+        for (slot, r) in hits.iter_mut().zip(&rays) {
+            *slot = sven_closest(&bvh, &shapes, r, &mut count);
+        }
+        closest.push(millis(start));
+        tested = count;
+        tree = Some(bvh);
+    }
+    let Some(bvh) = tree else {
+        return empty_measured();
+    };
+    let mut any = Vec::new();
+    let any_hits;
+    {
+        let start = Instant::now();
+        let mut n = 0usize;
+        for r in &rays {
+            let hit = bvh
+                .nearest_traverse_iterator(&r.ray, &shapes)
+                .any(|s| moller_trumbore(&s.v, r.o, r.d, r.t_min, r.t_max).is_some());
+            n += usize::from(hit);
+        }
+        any.push(millis(start));
+        any_hits = black_box(n);
+    }
+    PeerMeasured {
+        build_ms: median(&builds),
+        setup_ms,
+        closest_ms: median(&closest),
+        any_ms: median(&any),
+        hits,
+        any_hits,
+        prims_tested: tested,
+        bytes: std::mem::size_of_val(&bvh.nodes[..]),
+    }
+}

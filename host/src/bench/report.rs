@@ -1,0 +1,732 @@
+//! Writing the results: `BENCHMARKS.md` (Markdown report), `data.csv` (one figure per line),
+//! `data.json` (everything, structured) and `plots/*.png`.
+
+use super::machine::Machine;
+use super::plot::{grouped_bars, loglog, Series};
+use super::results::{ScaleRow, TraceRow};
+use super::workload::RayKind;
+use crate::error::Error;
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Everything one `host bench` run measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchResults {
+    /// Machine line data.
+    pub machine: Machine,
+    /// The command as typed (program name normalised).
+    pub command: String,
+    /// `--quick` run.
+    pub quick: bool,
+    /// Ray stride.
+    pub stride: usize,
+    /// Runs (medians).
+    pub runs: usize,
+    /// Where the rays came from.
+    pub ray_source: String,
+    /// Every trace row: ours and the peers, per scene and ray set.
+    pub rows: Vec<TraceRow>,
+    /// Per scene and ray set: rays and hits of the `f64` reference.
+    pub reference: Vec<ReferenceRow>,
+    /// The tiled-scene sweep.
+    pub scale: Vec<ScaleRow>,
+    /// Fitted log-log slopes of the plots.
+    pub slopes: Vec<SlopeRow>,
+    /// Wall time of the whole run, seconds.
+    pub elapsed_s: f64,
+}
+
+/// The `f64` reference's figures for one ray set.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReferenceRow {
+    /// Scene.
+    pub scene: String,
+    /// Ray set.
+    pub rays: RayKind,
+    /// Rays traced.
+    pub ray_count: usize,
+    /// Rays the reference hits.
+    pub hits: usize,
+}
+
+/// One fitted slope.
+#[derive(Clone, Debug, Serialize)]
+pub struct SlopeRow {
+    /// Plot file name.
+    pub plot: String,
+    /// Series.
+    pub series: String,
+    /// Slope of ln y against ln x.
+    pub slope: f64,
+}
+
+/// Files written.
+#[derive(Clone, Debug)]
+pub struct Written {
+    /// The Markdown report.
+    pub report: PathBuf,
+    /// The CSV.
+    pub csv: PathBuf,
+    /// The JSON.
+    pub json: PathBuf,
+    /// The plots.
+    pub plots: Vec<PathBuf>,
+}
+
+fn io_error(path: &Path, e: &std::io::Error) -> Error {
+    Error::Bench(format!("cannot write {}: {e}", path.display()))
+}
+
+/// Draws the plots (recording their slopes in `results`), then writes the report, CSV and
+/// JSON into `out`.
+///
+/// # Errors
+/// [`Error::Bench`] if a file cannot be written.
+pub fn write_all(results: &mut BenchResults, out: &Path) -> Result<Written, Error> {
+    let plots_dir = out.join("plots");
+    std::fs::create_dir_all(&plots_dir).map_err(|e| io_error(&plots_dir, &e))?;
+    let plots = draw_plots(results, &plots_dir)?;
+    let report = out.join("BENCHMARKS.md");
+    std::fs::write(&report, markdown(results)).map_err(|e| io_error(&report, &e))?;
+    let csv = out.join("data.csv");
+    std::fs::write(&csv, csv_text(results)).map_err(|e| io_error(&csv, &e))?;
+    let json = out.join("data.json");
+    let text = serde_json::to_string_pretty(results)
+        .map_err(|e| Error::Bench(format!("cannot encode the results: {e}")))?;
+    std::fs::write(&json, text + "\n").map_err(|e| io_error(&json, &e))?;
+    Ok(Written {
+        report,
+        csv,
+        json,
+        plots,
+    })
+}
+
+fn scenes(rows: &[TraceRow]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for r in rows {
+        if !out.contains(&r.scene) {
+            out.push(r.scene.clone());
+        }
+    }
+    out
+}
+
+fn labels(rows: &[TraceRow], pick: impl Fn(&TraceRow) -> bool) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for r in rows.iter().filter(|r| pick(r)) {
+        let l = r.label();
+        if !out.contains(&l) {
+            out.push(l);
+        }
+    }
+    out
+}
+
+/// The headline contenders of the speed plot: ours on the default builder, and the peers.
+fn headline(r: &TraceRow) -> bool {
+    !r.ours || r.builder == raykernel::bvh::BuilderKind::default().name()
+}
+
+fn draw_plots(results: &mut BenchResults, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+    let mut written = Vec::new();
+    let scene_names = scenes(&results.rows);
+    let mut slopes = Vec::new();
+    for kind in RayKind::ALL {
+        let rows: Vec<&TraceRow> = results.rows.iter().filter(|r| r.rays == kind).collect();
+        if rows.is_empty() {
+            continue;
+        }
+        // Speed: closest-hit Mrays/s per scene.
+        let path = dir.join(format!("speed_{}.png", kind.name()));
+        let series: Vec<(String, Vec<f64>)> =
+            labels(&results.rows, |r| r.rays == kind && headline(r))
+                .into_iter()
+                .map(|label| {
+                    let values = scene_names
+                        .iter()
+                        .map(|s| {
+                            rows.iter()
+                                .find(|r| &r.scene == s && r.label() == label)
+                                .map_or(0.0, |r| r.closest_mrays)
+                        })
+                        .collect();
+                    (label, values)
+                })
+                .collect();
+        grouped_bars(
+            &path,
+            &format!("Closest hit, {} rays, single thread", kind.name()),
+            "Mrays/s",
+            &scene_names,
+            &series,
+        )
+        .map_err(Error::Bench)?;
+        written.push(path);
+        // Error against speed, one series per family and builder, over the scenes.
+        let path = dir.join(format!("error_vs_speed_{}.png", kind.name()));
+        let mut groups: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+        for r in &rows {
+            let Some(a) = r.accuracy else { continue };
+            let name = if r.ours {
+                format!("{} {}", r.family(), r.builder)
+            } else {
+                r.family()
+            };
+            let point = (r.closest_mrays, a.t_rel_mean);
+            match groups.iter_mut().find(|g| g.0 == name) {
+                Some(g) => g.1.push(point),
+                None => groups.push((name, vec![point])),
+            }
+        }
+        let series: Vec<Series> = groups
+            .into_iter()
+            .map(|(name, points)| Series { name, points })
+            .collect();
+        let fitted = loglog(
+            &path,
+            &format!(
+                "Mean relative hit-distance error vs speed, {} rays",
+                kind.name()
+            ),
+            "closest hit, Mrays/s",
+            "mean |t - t*| / t*",
+            &series,
+        )
+        .map_err(Error::Bench)?;
+        for (s, slope) in series.iter().zip(fitted) {
+            if let Some(slope) = slope {
+                slopes.push(SlopeRow {
+                    plot: file_name(&path),
+                    series: s.name.clone(),
+                    slope,
+                });
+            }
+        }
+        written.push(path);
+    }
+    if !results.scale.is_empty() {
+        let modes: Vec<String> = {
+            let mut m: Vec<String> = Vec::new();
+            for r in &results.scale {
+                if !m.contains(&r.mode) {
+                    m.push(r.mode.clone());
+                }
+            }
+            m
+        };
+        let per_mode = |f: &dyn Fn(&ScaleRow) -> f64, suffix: &str| -> Vec<Series> {
+            modes
+                .iter()
+                .map(|m| Series {
+                    name: format!("{m}{suffix}"),
+                    points: results
+                        .scale
+                        .iter()
+                        .filter(|r| &r.mode == m)
+                        .map(|r| (r.triangles as f64, f(r)))
+                        .collect(),
+                })
+                .collect()
+        };
+        let path = dir.join("scale_build.png");
+        let series = per_mode(&|r| r.build_ms, " SAH build");
+        let fitted = loglog(
+            &path,
+            "SAH build time vs triangles (tiled scene)",
+            "triangles",
+            "build ms",
+            &series,
+        )
+        .map_err(Error::Bench)?;
+        record(&mut slopes, &path, &series, fitted);
+        written.push(path);
+        let path = dir.join("scale_trace.png");
+        let mut series = per_mode(&|r| r.primary_mrays, " primary");
+        series.extend(per_mode(&|r| r.incoherent_mrays, " incoherent"));
+        let fitted = loglog(
+            &path,
+            "Closest-hit Mrays/s vs triangles (tiled scene)",
+            "triangles",
+            "Mrays/s",
+            &series,
+        )
+        .map_err(Error::Bench)?;
+        record(&mut slopes, &path, &series, fitted);
+        written.push(path);
+    }
+    results.slopes = slopes;
+    Ok(written)
+}
+
+fn record(slopes: &mut Vec<SlopeRow>, path: &Path, series: &[Series], fitted: Vec<Option<f64>>) {
+    for (s, slope) in series.iter().zip(fitted) {
+        if let Some(slope) = slope {
+            slopes.push(SlopeRow {
+                plot: file_name(path),
+                series: s.name.clone(),
+                slope,
+            });
+        }
+    }
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// The reference row of a ray set: ours, `f32`, watertight, default builder.
+fn our_reference<'r>(rows: &'r [TraceRow], scene: &str, kind: RayKind) -> Option<&'r TraceRow> {
+    rows.iter().find(|r| {
+        r.ours
+            && r.scene == scene
+            && r.rays == kind
+            && r.mode == "f32"
+            && r.test == "watertight"
+            && r.builder == raykernel::bvh::BuilderKind::default().name()
+    })
+}
+
+fn fixed_reference<'r>(rows: &'r [TraceRow], scene: &str, kind: RayKind) -> Option<&'r TraceRow> {
+    rows.iter().find(|r| {
+        r.ours
+            && r.scene == scene
+            && r.rays == kind
+            && r.mode == "fixed"
+            && r.builder == raykernel::bvh::BuilderKind::default().name()
+    })
+}
+
+fn ratio(a: f64, b: f64) -> String {
+    if a > 0.0 && b > 0.0 {
+        format!("{:.2}×", a / b)
+    } else {
+        "-".into()
+    }
+}
+
+fn opt(x: Option<f64>, digits: usize) -> String {
+    x.map_or_else(|| "n/a".into(), |v| format!("{v:.digits$}"))
+}
+
+/// The Markdown report.
+#[must_use]
+pub fn markdown(r: &BenchResults) -> String {
+    let mut s = String::new();
+    let m = &r.machine;
+    let _ = writeln!(s, "# Benchmarks\n");
+    let _ = writeln!(s, "{}\n", m.line());
+    let _ = writeln!(s, "- command: `{}`", r.command);
+    let _ = writeln!(
+        s,
+        "- date: {}{}; wall time of the run: {:.0} s",
+        m.date,
+        m.commit
+            .as_ref()
+            .map_or(String::new(), |c| format!(", commit `{c}`")),
+        r.elapsed_s
+    );
+    let load = |l: Option<f64>| l.map_or_else(|| "unknown".into(), |v| format!("{v:.2}"));
+    let _ = writeln!(
+        s,
+        "- load average (1 min) at start / end: {} / {}{}",
+        load(m.load_start),
+        load(m.load_end),
+        if m.load_start.unwrap_or(0.0).max(m.load_end.unwrap_or(0.0)) > 0.5 {
+            " — other processes were using the cores, so times are noisy; rerun on a quiet \
+             machine for figures to quote"
+        } else {
+            ""
+        }
+    );
+    let _ = writeln!(
+        s,
+        "- workload: `shared/bench/WORKLOAD.md` scenes and ray sets ({}), {}, \
+         {} run{} (build + trace) per figure, medians; single thread{}",
+        r.ray_source,
+        if r.stride == 1 {
+            "all rays".to_string()
+        } else {
+            format!("every {}th ray", r.stride)
+        },
+        r.runs,
+        if r.runs == 1 { "" } else { "s" },
+        if r.quick {
+            "; **--quick** (CI smoke test: figures not for quoting)"
+        } else {
+            ""
+        }
+    );
+    if m.profile != "release" {
+        let _ = writeln!(
+            s,
+            "- **debug build: these figures are not meaningful** (use `--release`)"
+        );
+    }
+    let _ = writeln!(s);
+    headline_section(&mut s, r);
+    ours_section(&mut s, r);
+    peers_section(&mut s, r);
+    accuracy_section(&mut s, r);
+    s.push_str(&images_section(r));
+    scale_section(&mut s, r);
+    notes_section(&mut s);
+    s
+}
+
+fn headline_section(s: &mut String, r: &BenchResults) {
+    let peers = labels(&r.rows, |x| !x.ours);
+    let _ = writeln!(
+        s,
+        "## Headline: closest hit, Mrays/s, ours and peers in the same run\n"
+    );
+    let _ = writeln!(
+        s,
+        "Ratios are raykernel `f32` (SAH BVH, watertight) ÷ peer: above 1 means ours is faster.\n"
+    );
+    let mut head = "| scene | rays | raykernel f32 | raykernel fixed |".to_string();
+    let mut rule = "|---|---|---:|---:|".to_string();
+    for p in &peers {
+        let _ = write!(head, " {p} | ratio |");
+        rule.push_str("---:|---:|");
+    }
+    let _ = writeln!(s, "{head}\n{rule}");
+    for scene in scenes(&r.rows) {
+        for kind in RayKind::ALL {
+            let Some(ours) = our_reference(&r.rows, &scene, kind) else {
+                continue;
+            };
+            let fixed = fixed_reference(&r.rows, &scene, kind);
+            let mut line = format!(
+                "| {scene} | {} | {:.2} | {} |",
+                kind.name(),
+                ours.closest_mrays,
+                fixed.map_or("-".into(), |f| format!("{:.2}", f.closest_mrays))
+            );
+            for p in &peers {
+                match r
+                    .rows
+                    .iter()
+                    .find(|x| x.scene == scene && x.rays == kind && &x.label() == p)
+                {
+                    Some(x) => {
+                        let _ = write!(
+                            line,
+                            " {:.2} | {} |",
+                            x.closest_mrays,
+                            ratio(ours.closest_mrays, x.closest_mrays)
+                        );
+                    }
+                    None => line.push_str(" - | - |"),
+                }
+            }
+            let _ = writeln!(s, "{line}");
+        }
+    }
+    let _ = writeln!(
+        s,
+        "\n![closest hit, primary rays](plots/speed_primary.png)\n\
+         ![closest hit, incoherent rays](plots/speed_incoherent.png)\n"
+    );
+}
+
+fn ours_section(s: &mut String, r: &BenchResults) {
+    let _ = writeln!(
+        s,
+        "## Traversal: every accelerator, builder and mode of the kernel\n"
+    );
+    let _ = writeln!(
+        s,
+        "Leaves of up to 4 primitives. `any hit` is `occluded` (first hit in range), timed once on the last run. Nodes \
+         and primitives are counted per closest-hit ray. Bytes per triangle count the nodes \
+         in use and the primitive ids (not the triangles). `MT` is the benchmark-only \
+         Möller–Trumbore test on the same tree (a contrast, not part of the kernel).\n"
+    );
+    let _ = writeln!(
+        s,
+        "| scene | rays | accel | builder | mode | test | build ms | closest Mrays/s | any-hit Mrays/s | setup ms | nodes/ray | prims/ray | bytes/tri | depth |"
+    );
+    let _ = writeln!(
+        s,
+        "|---|---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for x in r.rows.iter().filter(|x| x.ours) {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.2} | {:.1} | {} | {} | {:.1} | {} |",
+            x.scene,
+            x.rays.name(),
+            x.contender.trim_start_matches("raykernel "),
+            x.builder,
+            x.mode,
+            x.test,
+            x.build_ms,
+            x.closest_mrays,
+            x.any_mrays,
+            x.setup_ms,
+            opt(x.nodes_per_ray, 1),
+            opt(x.prims_per_ray, 1),
+            x.bytes_per_tri,
+            x.depth.map_or("-".into(), |d| d.to_string())
+        );
+    }
+    let _ = writeln!(s);
+}
+
+fn peers_section(s: &mut String, r: &BenchResults) {
+    let _ = writeln!(s, "## Peers: same triangles, same rays, same run\n");
+    let _ = writeln!(
+        s,
+        "Throughput ratios are ours ÷ peer, build ratio is peer time ÷ our time (both: above \
+         1 means ours is faster); ours is raykernel `f32`, SAH, watertight. Agreement with our \
+         hits follows `compare_hits.py` (same prim and |Δt| ≤ 1e-5·t); `ties` = t agrees but \
+         the prim differs; `hit/miss` = one side hits, the other misses. Peers cannot count \
+         nodes visited.\n"
+    );
+    let _ = writeln!(
+        s,
+        "| scene | rays | peer | build ms | build ratio | closest Mrays/s | ratio | any-hit Mrays/s | ratio | prims/ray | bytes/tri | agree % | ties | hit/miss | hits ours / peer |"
+    );
+    let _ = writeln!(
+        s,
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for x in r.rows.iter().filter(|x| !x.ours) {
+        let Some(ours) = our_reference(&r.rows, &x.scene, x.rays) else {
+            continue;
+        };
+        let c = x.vs_ours;
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {:.1} | {} | {:.2} | {} | {:.2} | {} | {} | {:.1} | {} | {} | {} | {} / {} |",
+            x.scene,
+            x.rays.name(),
+            x.contender,
+            x.build_ms,
+            ratio(x.build_ms, ours.build_ms),
+            x.closest_mrays,
+            ratio(ours.closest_mrays, x.closest_mrays),
+            x.any_mrays,
+            ratio(ours.any_mrays, x.any_mrays),
+            opt(x.prims_per_ray, 1),
+            x.bytes_per_tri,
+            c.map_or("-".into(), |c| format!("{:.3}", c.agree_pct)),
+            c.map_or("-".into(), |c| c.prim_only.to_string()),
+            c.map_or("-".into(), |c| c.hitmiss.to_string()),
+            ours.hits,
+            x.hits
+        );
+    }
+    let _ = writeln!(s);
+}
+
+fn accuracy_section(s: &mut String, r: &BenchResults) {
+    let _ = writeln!(s, "## Accuracy against an f64 reference\n");
+    let _ = writeln!(
+        s,
+        "The reference runs the kernel's watertight algorithm in `f64` on the same `f32` \
+         vertices and ray records (closest hit, ties to the lowest id). `max`/`mean rel Δt`: \
+         |t − t*| / t*, with t* the `f64` distance to the plane of the triangle the contender \
+         reported. `wrong prim`: both hit, different surfaces (|Δt| > 1e-5·t); `ties`: \
+         different triangle at the same distance; `leaks`: the reference hits, the contender \
+         misses; `false hits`: the reverse.\n"
+    );
+    for row in &r.reference {
+        let _ = writeln!(
+            s,
+            "- {} {}: the reference hits {} of {} rays",
+            row.scene,
+            row.rays.name(),
+            row.hits,
+            row.ray_count
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\n| scene | rays | contender | max rel Δt | mean rel Δt | wrong prim | ties | leaks | false hits | closest Mrays/s |"
+    );
+    let _ = writeln!(s, "|---|---|---|---:|---:|---:|---:|---:|---:|---:|");
+    for x in &r.rows {
+        let Some(a) = x.accuracy else { continue };
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {:.2e} | {:.2e} | {} | {} | {} | {} | {:.2} |",
+            x.scene,
+            x.rays.name(),
+            x.label(),
+            a.t_rel_max,
+            a.t_rel_mean,
+            a.wrong_prim,
+            a.ties,
+            a.leaks,
+            a.false_hits,
+            x.closest_mrays
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\n![error vs speed, primary](plots/error_vs_speed_primary.png)\n\
+         ![error vs speed, incoherent](plots/error_vs_speed_incoherent.png)\n"
+    );
+    let _ = writeln!(
+        s,
+        "Fitted slopes (least squares of ln error against ln Mrays/s over the scenes; with \
+         three points per series they describe the spread, not a law):\n"
+    );
+    let _ = writeln!(s, "| plot | series | slope |\n|---|---|---:|");
+    for sl in r.slopes.iter().filter(|x| x.plot.starts_with("error")) {
+        let _ = writeln!(s, "| {} | {} | {:.2} |", sl.plot, sl.series, sl.slope);
+    }
+    let _ = writeln!(s);
+}
+
+/// Extension point for the renderer's convergence figures (RMSE against time per sampler,
+/// with fitted slopes): returns the report's `## Images` section. Until the renderer exists it
+/// says so; fill `BenchResults` with the image rows and render them here.
+#[must_use]
+pub fn images_section(_results: &BenchResults) -> String {
+    "## Images: renderer RMSE against time per sampler\n\nPending: the distribution ray \
+     tracer does not exist yet. This section comes from `host::bench::report::images_section`, \
+     the place to add its RMSE-vs-time plot and fitted slopes.\n\n"
+        .to_string()
+}
+
+fn scale_section(s: &mut String, r: &BenchResults) {
+    let _ = writeln!(s, "## Scale: tiled scene from 10k to 1M+ triangles\n");
+    if r.scale.is_empty() {
+        let _ = writeln!(s, "Not run.\n");
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "Copies of the benchmark meshes on a grid of 10×10 cells (make_tiled.py's recipe with \
+         SplitMix64 instead of numpy's generator; the last instance cut to the exact count) \
+         plus a ground plane; SAH BVH, leaves of up to 4; {} rays per set (primary from the \
+         3/4 camera, incoherent in the scene box).\n",
+        r.scale.first().map_or(0, |x| x.ray_count)
+    );
+    let _ = writeln!(
+        s,
+        "| triangles | instances | mode | build ms | bytes/tri | primary Mrays/s | incoherent Mrays/s | nodes/incoherent ray |"
+    );
+    let _ = writeln!(s, "|---:|---:|---|---:|---:|---:|---:|---:|");
+    for x in &r.scale {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {:.1} | {:.1} | {:.2} | {:.2} | {:.1} |",
+            x.triangles,
+            x.instances,
+            x.mode,
+            x.build_ms,
+            x.bytes_per_tri,
+            x.primary_mrays,
+            x.incoherent_mrays,
+            x.incoherent_nodes_per_ray
+        );
+    }
+    let _ = writeln!(s, "\nFitted log-log slopes against the triangle count:\n");
+    let _ = writeln!(s, "| plot | series | slope |\n|---|---|---:|");
+    for sl in r.slopes.iter().filter(|x| x.plot.starts_with("scale")) {
+        let _ = writeln!(s, "| {} | {} | {:.2} |", sl.plot, sl.series, sl.slope);
+    }
+    let _ = writeln!(
+        s,
+        "\n![build time](plots/scale_build.png)\n![trace speed](plots/scale_trace.png)\n"
+    );
+}
+
+fn notes_section(s: &mut String) {
+    let _ = writeln!(
+        s,
+        "## Method\n\n\
+         - Build: wall time of the call that turns the triangle array into the structure \
+         that is traversed (ours: `Bvh::build` into a 64-byte aligned arena; obvhs: \
+         `build_bvh2_from_tris` / `build_cwbvh_from_tris` with `BvhBuildParams::medium_build()`; \
+         bvh: `Bvh::build`), parsing excluded.\n\
+         - Trace: wall time of tracing every ray and storing `{{t, prim}}`; turning records \
+         into each library's ray type is timed apart (`setup ms`).\n\
+         - Peers' triangle tests: obvhs uses its own two-sided Möller–Trumbore; bvh's \
+         `intersects_triangle` culls back faces, so its rows use this benchmark's two-sided \
+         Möller–Trumbore and its `nearest_traverse_iterator` (boxes in order of entry, stopped \
+         past the best hit). Peers' bytes/tri: obvhs nodes + primitive indices; bvh nodes only.\n\
+         - Criterion micro-benchmarks of the hot functions (slab test, triangle test, one \
+         traversal): `cargo bench -p raykernel-host --bench hot`.\n"
+    );
+}
+
+/// The CSV: one figure per line, `section,scene,rays,contender,builder,test,mode,metric,value`.
+#[must_use]
+pub fn csv_text(r: &BenchResults) -> String {
+    let mut s = String::from("section,scene,rays,contender,builder,test,mode,metric,value\n");
+    let mut line = |section: &str, x: &TraceRow, metric: &str, value: f64| {
+        let _ = writeln!(
+            s,
+            "{section},{},{},{},{},{},{},{metric},{value}",
+            x.scene,
+            x.rays.name(),
+            x.contender,
+            x.builder,
+            x.test,
+            x.mode
+        );
+    };
+    for x in &r.rows {
+        let section = if x.ours { "traversal" } else { "peer" };
+        line(section, x, "rays", x.ray_count as f64);
+        line(section, x, "triangles", x.triangles as f64);
+        line(section, x, "build_ms", x.build_ms);
+        line(section, x, "setup_ms", x.setup_ms);
+        line(section, x, "closest_mrays", x.closest_mrays);
+        line(section, x, "any_mrays", x.any_mrays);
+        if let Some(v) = x.nodes_per_ray {
+            line(section, x, "nodes_per_ray", v);
+        }
+        if let Some(v) = x.prims_per_ray {
+            line(section, x, "prims_per_ray", v);
+        }
+        line(section, x, "bytes_per_tri", x.bytes_per_tri);
+        if let Some(d) = x.depth {
+            line(section, x, "depth", f64::from(d));
+        }
+        line(section, x, "hits", x.hits as f64);
+        line(section, x, "any_hits", x.any_hits as f64);
+        if let Some(c) = x.vs_ours {
+            line("agreement", x, "agree_pct", c.agree_pct);
+            line("agreement", x, "ties", c.prim_only as f64);
+            line("agreement", x, "hitmiss", c.hitmiss as f64);
+        }
+        if let Some(a) = x.accuracy {
+            line("accuracy", x, "t_rel_max", a.t_rel_max);
+            line("accuracy", x, "t_rel_mean", a.t_rel_mean);
+            line("accuracy", x, "wrong_prim", a.wrong_prim as f64);
+            line("accuracy", x, "ties", a.ties as f64);
+            line("accuracy", x, "leaks", a.leaks as f64);
+            line("accuracy", x, "false_hits", a.false_hits as f64);
+        }
+    }
+    for x in &r.scale {
+        for (metric, value) in [
+            ("triangles", x.triangles as f64),
+            ("instances", x.instances as f64),
+            ("build_ms", x.build_ms),
+            ("bytes_per_tri", x.bytes_per_tri),
+            ("rays", x.ray_count as f64),
+            ("primary_mrays", x.primary_mrays),
+            ("incoherent_mrays", x.incoherent_mrays),
+            ("incoherent_nodes_per_ray", x.incoherent_nodes_per_ray),
+        ] {
+            let _ = writeln!(
+                s,
+                "scale,tiled-{},,raykernel bvh,{},watertight,{},{metric},{value}",
+                x.triangles, x.builder, x.mode
+            );
+        }
+    }
+    for x in &r.slopes {
+        let _ = writeln!(s, "fit,{},,{},,,,slope,{}", x.plot, x.series, x.slope);
+    }
+    s
+}
