@@ -11,8 +11,8 @@ use raykernel::bvh::{nodes_needed, BuildOptions};
 use raykernel::geom::spawn::{spawn_shadow_ray, SpawnScalar};
 use raykernel::glam::Vec3;
 use raykernel::render::{
-    encode_srgb8, AccelChoice, AccelMemory, Camera, Light, Material, Object, Renderer, Scene,
-    Settings, Shape,
+    encode_srgb8, AccelChoice, AccelMemory, Camera, Light, Material, Object, ObjectSlot, Renderer,
+    Scene, Settings, Shape,
 };
 use raykernel::{Accel, Bvh, Node, Ray, Triangle, I16F16};
 use std::hint::black_box;
@@ -126,7 +126,9 @@ fn bench_mode<S: SpawnScalar>(c: &mut Criterion) {
     };
     let mut nodes2 = vec![Node::EMPTY; nodes_needed(tris.len())];
     let mut ids2 = vec![0u32; tris.len()];
+    let mut slots = [ObjectSlot::EMPTY; 1];
     let memory = AccelMemory {
+        objects: &mut slots,
         bvh_nodes: &mut nodes2,
         kd_nodes: &mut [],
         words: &mut ids2,

@@ -12,8 +12,8 @@ use raykernel::bvh::BuildOptions;
 use raykernel::geom::spawn::SpawnScalar;
 use raykernel::render::scenes::SceneData;
 use raykernel::render::{
-    encode_srgb8, memory_needed, AccelChoice, AccelMemory, Object, RenderPlan, RenderStats,
-    Renderer, Rgb, SceneError, Settings, Shape, Tile,
+    encode_srgb8, memory_needed, AccelChoice, AccelMemory, Object, ObjectSlot, RenderPlan,
+    RenderStats, Renderer, Rgb, SceneError, Settings, Shape, Tile,
 };
 use raykernel::{GridOptions, KdNode, KdOptions, Node, Scalar, Sphere, Triangle, I16F16};
 use rayon::prelude::*;
@@ -157,10 +157,12 @@ pub fn with_renderer<S: SpawnScalar, R>(
     let mut objects = vec![Object::new(Shape::Triangles(&[]), 0); data.objects.len()];
     let scene = data.scene(&triangles, &spheres, &mut objects)?;
     let need = memory_needed(scene.objects, accel);
+    let mut slots = vec![ObjectSlot::EMPTY; need.objects];
     let mut bvh_nodes = vec![Node::<S>::EMPTY; need.bvh_nodes];
     let mut kd_nodes = vec![KdNode::<S>::EMPTY; need.kd_nodes];
     let mut words = vec![0u32; need.words];
     let memory = AccelMemory {
+        objects: &mut slots,
         bvh_nodes: &mut bvh_nodes,
         kd_nodes: &mut kd_nodes,
         words: &mut words,

@@ -11,8 +11,8 @@ use raykernel::render::sampling::{
 use raykernel::render::scenes::{self, SceneData};
 use raykernel::render::{
     memory_needed, AccelChoice, AccelMemory, Camera, Filter, Item, Light, Material, MemoryNeeded,
-    Object, Problem, Renderer, SamplerKind, Scene, SceneError, Settings, Shape, Tile, MAX_LIGHTS,
-    MAX_OBJECTS,
+    Object, ObjectSlot, Problem, Renderer, SamplerKind, Scene, SceneError, Settings, Shape, Tile,
+    MAX_LIGHTS,
 };
 use raykernel::{GridOptions, KdNode, KdOptions, Node, Sphere, Triangle, I16F16};
 use std::f64::consts::PI;
@@ -63,25 +63,28 @@ fn cube(half: f32, x_offset: f32) -> Vec<[[f32; 3]; 3]> {
 }
 
 /// Accelerator buffers of the sizes [`memory_needed`] gives.
-struct Memory<S: SpawnScalar> {
+struct Memory<'m, S: SpawnScalar> {
+    objects: Vec<ObjectSlot<'m, S>>,
     bvh_nodes: Vec<Node<S>>,
     kd_nodes: Vec<KdNode<S>>,
     words: Vec<u32>,
 }
 
-impl<S: SpawnScalar> Memory<S> {
+impl<'m, S: SpawnScalar> Memory<'m, S> {
     fn new(scene: &Scene<'_, S>, accel: AccelChoice) -> Self {
         Self::sized(memory_needed(scene.objects, accel))
     }
     fn sized(n: MemoryNeeded) -> Self {
         Self {
+            objects: vec![ObjectSlot::EMPTY; n.objects],
             bvh_nodes: vec![Node::EMPTY; n.bvh_nodes],
             kd_nodes: vec![KdNode::EMPTY; n.kd_nodes],
             words: vec![0; n.words],
         }
     }
-    fn lend(&mut self) -> AccelMemory<'_, S> {
+    fn lend(&'m mut self) -> AccelMemory<'m, S> {
         AccelMemory {
+            objects: &mut self.objects,
             bvh_nodes: &mut self.bvh_nodes,
             kd_nodes: &mut self.kd_nodes,
             words: &mut self.words,
@@ -772,12 +775,7 @@ fn bad_scene_data_gives_typed_errors() {
         check_error(&moving, &diffuse, &point, cam, st),
         e(Item::Object, 0, "motion", Problem::NonFinite)
     );
-    // Too many objects and lights.
-    let many = vec![good_obj[0]; MAX_OBJECTS + 1];
-    assert_eq!(
-        check_error(&many, &diffuse, &point, cam, st).problem,
-        Problem::TooMany { max: MAX_OBJECTS }
-    );
+    // Too many lights (objects are bounded by the caller's slots).
     let lights = vec![point[0]; MAX_LIGHTS + 1];
     assert_eq!(
         check_error(&good_obj, &diffuse, &lights, cam, st).problem,
@@ -816,6 +814,7 @@ fn buffers_and_tiles_are_checked_exactly() {
     let kd_need = memory_needed(scene.objects, kd);
     let grid_need = memory_needed(scene.objects, grid);
     let need = |bvh_nodes, kd_nodes, words| MemoryNeeded {
+        objects: 2,
         bvh_nodes,
         kd_nodes,
         words,
@@ -828,6 +827,7 @@ fn buffers_and_tiles_are_checked_exactly() {
     // One element short in each buffer: a typed error naming it, with the exact sizes.
     for (accel, n) in [(bvh, bvh_need), (kd, kd_need), (grid, grid_need)] {
         let shorts = [
+            ("object_slots", 2, MemoryNeeded { objects: 1, ..n }),
             (
                 "bvh_nodes",
                 n.bvh_nodes,
@@ -857,7 +857,12 @@ fn buffers_and_tiles_are_checked_exactly() {
         assert!(Renderer::new(&scene, st, accel, memory.lend()).is_ok());
     }
     // Brute force needs no memory at all.
-    let r = Renderer::new(&scene, st, AccelChoice::Linear, AccelMemory::default()).unwrap();
+    let mut slots = [ObjectSlot::EMPTY; 2];
+    let memory = AccelMemory {
+        objects: &mut slots,
+        ..AccelMemory::default()
+    };
+    let r = Renderer::new(&scene, st, AccelChoice::Linear, memory).unwrap();
     let mut out = vec![0u8; 4 * 3 * 3];
     r.render_srgb8(&mut out).unwrap();
     let err = r.render_srgb8(&mut out[..35]).unwrap_err();

@@ -11,7 +11,7 @@
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::geom::spawn::SpawnScalar;
 use raykernel::render::scenes::{self, SceneData};
-use raykernel::render::{AccelChoice, AccelMemory, Object, Renderer, Shape, Tile};
+use raykernel::render::{AccelChoice, AccelMemory, Object, ObjectSlot, Renderer, Shape, Tile};
 use raykernel::{Accel, Bvh, Hit, Linear, Node, Primitive, Ray, Scalar, Sphere, Triangle, I16F16};
 
 /// Triangles of the level-1 icosphere.
@@ -416,7 +416,9 @@ pub fn render_hash<S: Bits + SpawnScalar>(data: &SceneData<'_>) -> Result<u64, F
         nodes_needed(RENDER_TRIS) + nodes_needed(RENDER_SPHERES) + 2 * RENDER_OBJECTS];
     let mut ids = [0u32; RENDER_TRIS + RENDER_SPHERES];
     let accel = AccelChoice::default();
+    let mut slots = [ObjectSlot::EMPTY; RENDER_OBJECTS];
     let memory = AccelMemory {
+        objects: &mut slots,
         bvh_nodes: &mut nodes,
         kd_nodes: &mut [],
         words: &mut ids,

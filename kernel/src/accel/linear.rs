@@ -12,7 +12,7 @@ pub struct Linear<'a, S: Scalar, P: Primitive<S>> {
 
 impl<'a, S: Scalar, P: Primitive<S>> Linear<'a, S, P> {
     /// Wraps the primitives; nothing is built.
-    pub fn new(prims: &'a [P]) -> Self {
+    pub const fn new(prims: &'a [P]) -> Self {
         Self {
             prims,
             _scalar: PhantomData,

@@ -28,9 +28,6 @@ use crate::scalar::Scalar;
 /// solves a quadratic: its roots near the surface carry more rounding than a plane's).
 pub const SPHERE_SPAWN_FACTOR: f64 = 8.0;
 
-/// Most objects a scene may have (the renderer keeps one accelerator per object inline, so
-/// this bounds its size: about 100 bytes per object on 32-bit targets).
-pub const MAX_OBJECTS: usize = 16;
 /// Most lights a scene may have.
 pub const MAX_LIGHTS: usize = 8;
 
@@ -69,6 +66,8 @@ impl<S: Scalar, P: Primitive<S>> Index<'_, S, P> {
 /// Objects take their share from the front, in scene order.
 #[derive(Debug)]
 pub struct AccelMemory<'a, S: Scalar> {
+    /// One slot per object (every [`AccelChoice`], brute force included).
+    pub objects: &'a mut [ObjectSlot<'a, S>],
     /// BVH nodes ([`AccelChoice::Bvh`]).
     pub bvh_nodes: &'a mut [Node<S>],
     /// Kd-tree nodes ([`AccelChoice::KdTree`]).
@@ -78,9 +77,10 @@ pub struct AccelMemory<'a, S: Scalar> {
 }
 
 impl<S: Scalar> Default for AccelMemory<'_, S> {
-    /// No memory: enough for [`AccelChoice::Linear`].
+    /// No memory at all: enough for a scene without objects.
     fn default() -> Self {
         Self {
+            objects: &mut [],
             bvh_nodes: &mut [],
             kd_nodes: &mut [],
             words: &mut [],
@@ -92,6 +92,8 @@ impl<S: Scalar> Default for AccelMemory<'_, S> {
 /// its objects.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct MemoryNeeded {
+    /// Length of [`AccelMemory::objects`]: the scene's object count.
+    pub objects: usize,
     /// Length of [`AccelMemory::bvh_nodes`].
     pub bvh_nodes: usize,
     /// Length of [`AccelMemory::kd_nodes`].
@@ -104,8 +106,12 @@ impl MemoryNeeded {
     /// The total in bytes for mode `S`.
     #[must_use]
     pub const fn bytes<S: Scalar>(&self) -> usize {
-        self.bvh_nodes
-            .saturating_mul(core::mem::size_of::<Node<S>>())
+        self.objects
+            .saturating_mul(core::mem::size_of::<ObjectSlot<'_, S>>())
+            .saturating_add(
+                self.bvh_nodes
+                    .saturating_mul(core::mem::size_of::<Node<S>>()),
+            )
             .saturating_add(
                 self.kd_nodes
                     .saturating_mul(core::mem::size_of::<KdNode<S>>()),
@@ -115,6 +121,7 @@ impl MemoryNeeded {
 
     fn add(self, o: Self) -> Self {
         Self {
+            objects: self.objects.saturating_add(o.objects),
             bvh_nodes: self.bvh_nodes.saturating_add(o.bvh_nodes),
             kd_nodes: self.kd_nodes.saturating_add(o.kd_nodes),
             words: self.words.saturating_add(o.words),
@@ -126,7 +133,10 @@ impl MemoryNeeded {
 /// its build reports the error.
 fn needed_for<S: Scalar, P: Primitive<S>>(prims: &[P], choice: AccelChoice) -> MemoryNeeded {
     let n = prims.len();
-    let none = MemoryNeeded::default();
+    let none = MemoryNeeded {
+        objects: 1,
+        ..MemoryNeeded::default()
+    };
     match choice {
         AccelChoice::Linear => none,
         AccelChoice::Bvh(_) => MemoryNeeded {
@@ -157,6 +167,9 @@ fn take<'a, T>(buf: &mut &'a mut [T], n: usize) -> &'a mut [T] {
     mine
 }
 
+/// Builds one object's accelerator. Never inlined: the builders' working memory (BVH bins and
+/// pending nodes, about 6 KB) then sits on the stack once, not once per primitive type.
+#[inline(never)]
 fn build_index<'a, S: Scalar, P: Primitive<S>>(
     prims: &'a [P],
     choice: AccelChoice,
@@ -216,6 +229,24 @@ impl<S: Scalar> ShapeIndex<'_, S> {
     }
 }
 
+/// Room for one object's built accelerator and placement in the caller's memory
+/// ([`AccelMemory::objects`], one slot per object, filled by the renderer). Opaque: make
+/// arrays of [`ObjectSlot::EMPTY`].
+#[derive(Clone, Copy, Debug)]
+pub struct ObjectSlot<'a, S: Scalar>(ObjectGeom<'a, S>);
+
+impl<S: Scalar> ObjectSlot<'_, S> {
+    /// An unused slot.
+    pub const EMPTY: Self = Self(ObjectGeom {
+        index: ShapeIndex::Triangles(Index::Linear(Linear::new(&[]))),
+        shape: Shape::Triangles(&[]),
+        base: 0,
+        material: 0,
+        motion: None,
+        swept: Aabb::new([S::ZERO; 3], [S::ZERO; 3]),
+    });
+}
+
 /// An object ready for queries.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct ObjectGeom<'a, S: Scalar> {
@@ -261,7 +292,8 @@ pub(crate) struct SceneHit<S: Scalar> {
 /// Every object and light of a scene, ready for queries at a shutter time.
 #[derive(Clone, Debug)]
 pub(crate) struct Geometry<'a, S: Scalar> {
-    pub(crate) objects: heapless::Vec<ObjectGeom<'a, S>, MAX_OBJECTS>,
+    /// One filled slot per object, in scene order.
+    objects: &'a [ObjectSlot<'a, S>],
     pub(crate) lights: heapless::Vec<LightGeom<S>, MAX_LIGHTS>,
     /// Global id of the first light.
     light_base: u32,
@@ -292,9 +324,6 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
         mut memory: AccelMemory<'a, S>,
     ) -> Result<Self, SceneError> {
         let err = |index, field, problem| SceneError::new(Item::Object, index, field, problem);
-        if objects.len() > MAX_OBJECTS {
-            return Err(err(0, "objects", Problem::TooMany { max: MAX_OBJECTS }));
-        }
         if lights.len() > MAX_LIGHTS {
             return Err(SceneError::new(
                 Item::Light,
@@ -305,6 +334,7 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
         }
         let need = memory_needed(objects, choice);
         for (field, needed, available) in [
+            ("object_slots", need.objects, memory.objects.len()),
             ("bvh_nodes", need.bvh_nodes, memory.bvh_nodes.len()),
             ("kd_nodes", need.kd_nodes, memory.kd_nodes.len()),
             ("words", need.words, memory.words.len()),
@@ -313,13 +343,9 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
                 return Err(err(0, field, Problem::TooSmall { needed, available }));
             }
         }
-        let mut geo = Self {
-            objects: heapless::Vec::new(),
-            lights: heapless::Vec::new(),
-            light_base: 0,
-        };
+        let slots = take(&mut memory.objects, objects.len());
         let mut base = 0u32;
-        for (i, o) in objects.iter().enumerate() {
+        for (i, (o, slot)) in objects.iter().zip(slots.iter_mut()).enumerate() {
             let bad = |e| err(i, "shape", Problem::Build(e));
             if !super::scene::finite3(o.motion) {
                 return Err(err(i, "motion", Problem::NonFinite));
@@ -348,8 +374,7 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
                 motion,
                 swept,
             };
-            // Capacity checked above.
-            let _ = geo.objects.push(g);
+            *slot = ObjectSlot(g);
             base = base.checked_add(len).ok_or(err(
                 i,
                 "shape",
@@ -358,7 +383,11 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
                 }),
             ))?;
         }
-        geo.light_base = base;
+        let mut geo = Self {
+            objects: slots,
+            lights: heapless::Vec::new(),
+            light_base: base,
+        };
         for (i, l) in lights.iter().enumerate() {
             let _ = geo.lights.push(
                 light_geom(l)
@@ -393,6 +422,18 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
         Some(query(&o.index, &moved, c))
     }
 
+    /// The objects, in scene order.
+    #[inline]
+    pub(crate) fn objects(&self) -> impl Iterator<Item = &ObjectGeom<'a, S>> {
+        self.objects.iter().map(|s| &s.0)
+    }
+
+    /// Object `i`.
+    #[inline]
+    pub(crate) fn object(&self, i: usize) -> Option<&ObjectGeom<'a, S>> {
+        self.objects.get(i).map(|s| &s.0)
+    }
+
     /// Closest hit at shutter time `time`; ties to the lowest global id.
     pub(crate) fn intersect<C: Counters>(
         &self,
@@ -402,7 +443,7 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
     ) -> Option<SceneHit<S>> {
         let mut best: Option<SceneHit<S>> = None;
         let mut best_t = ray.t_max();
-        for (i, o) in self.objects.iter().enumerate() {
+        for (i, o) in self.objects().enumerate() {
             let Ok(r) = ray.with_interval(ray.t_min(), best_t) else {
                 continue;
             };
@@ -457,8 +498,7 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
 
     /// Any object hit in the ray's interval at shutter time `time` (lights cast no shadow).
     pub(crate) fn occluded<C: Counters>(&self, ray: &Ray<S>, time: f32, c: &mut C) -> bool {
-        self.objects
-            .iter()
+        self.objects()
             .any(|o| Self::query_object(o, ray, time, c, ShapeIndex::occluded) == Some(true))
     }
 
@@ -473,7 +513,7 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
         let Surface::Object { object, local } = h.surface else {
             return None;
         };
-        let o = self.objects.get(object)?;
+        let o = self.object(object)?;
         let d = o.motion.map_or([0.0; 3], |m| displacement::<S>(m, time));
         match o.shape {
             Shape::Triangles(t) => {

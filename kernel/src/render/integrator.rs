@@ -56,8 +56,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar>(
         };
         let material = r
             .geometry
-            .objects
-            .get(object)
+            .object(object)
             .and_then(|o| r.materials.get(o.material as usize));
         // Emitters end the path: no surface point needed.
         let material = match material {

@@ -24,7 +24,7 @@ mod scene;
 pub mod scenes;
 
 pub use geometry::{
-    memory_needed, AccelMemory, MemoryNeeded, MAX_LIGHTS, MAX_OBJECTS, SPHERE_SPAWN_FACTOR,
+    memory_needed, AccelMemory, MemoryNeeded, ObjectSlot, MAX_LIGHTS, SPHERE_SPAWN_FACTOR,
 };
 pub use sampling::SamplerKind;
 pub use scene::{
@@ -161,6 +161,18 @@ pub struct Tile {
     pub height: u32,
 }
 
+impl Tile {
+    /// Image coordinates of the tile's `i`-th pixel in row-major order (an empty tile has no
+    /// pixels; its width is taken as 1 so that nothing divides by zero).
+    const fn pixel_at(self, i: usize) -> (u32, u32) {
+        let (i, width) = (i as u32, if self.width == 0 { 1 } else { self.width });
+        (
+            self.x.wrapping_add(i % width),
+            self.y.wrapping_add(i / width),
+        )
+    }
+}
+
 /// Rays a render cast.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RenderStats {
@@ -270,8 +282,8 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
         let n = self.check_tile(tile, out.len(), 1)?;
         let mut stats = RenderStats::default();
         for (i, px) in out.iter_mut().take(n).enumerate() {
-            let (dx, dy) = ((i as u32) % tile.width, (i as u32) / tile.width);
-            *px = self.pixel(tile.x + dx, tile.y + dy, &mut stats);
+            let (x, y) = tile.pixel_at(i);
+            *px = self.pixel(x, y, &mut stats);
         }
         Ok(stats)
     }
@@ -284,8 +296,8 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
         let n = self.check_tile(tile, out.len(), 3)?;
         let mut stats = RenderStats::default();
         for (i, px) in out.chunks_exact_mut(3).take(n).enumerate() {
-            let (dx, dy) = ((i as u32) % tile.width, (i as u32) / tile.width);
-            let c = self.pixel(tile.x + dx, tile.y + dy, &mut stats);
+            let (x, y) = tile.pixel_at(i);
+            let c = self.pixel(x, y, &mut stats);
             for (b, v) in px.iter_mut().zip(c) {
                 *b = encode_srgb8(v);
             }

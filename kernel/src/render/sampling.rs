@@ -14,6 +14,7 @@
 //!   Scrambling"): no tables, low discrepancy at every power-of-two sample count.
 
 use core::f32::consts::PI;
+use core::num::NonZeroU32;
 use glam::Vec3;
 
 /// How sample points are placed within a pixel's sample set.
@@ -137,7 +138,8 @@ pub struct Sampler {
     kind: SamplerKind,
     spp: u32,
     seed: u32,
-    cols: u32,
+    /// Non-zero: the grid divides by it.
+    cols: NonZeroU32,
     rows: u32,
 }
 
@@ -145,13 +147,14 @@ impl Sampler {
     /// A sampler for `spp` samples per pixel.
     #[must_use]
     pub fn new(kind: SamplerKind, spp: u32, seed: u32) -> Self {
-        let cols = ceil_sqrt(spp);
+        // At least one column (spp = 0 renders nothing, but must not divide by zero).
+        let cols = NonZeroU32::new(ceil_sqrt(spp)).unwrap_or(NonZeroU32::MIN);
         Self {
             kind,
             spp,
             seed,
             cols,
-            rows: spp.div_ceil(cols).max(1),
+            rows: (spp / cols + u32::from(spp % cols != 0)).max(1),
         }
     }
 
@@ -212,7 +215,7 @@ impl SampleStream {
                 let jx = unit_float(h);
                 let jy = unit_float(hash(h ^ 0x68e3_1da4));
                 (
-                    below_one((cx as f32 + jx) / cols as f32),
+                    below_one((cx as f32 + jx) / cols.get() as f32),
                     below_one((cy as f32 + jy) / rows as f32),
                 )
             }

@@ -33,12 +33,15 @@ pub fn check_golden(name: &str) {
     check_golden_with(name, cases::compute)
 }
 
-/// As [`check_golden`] for a render case.
-pub fn check_render_golden(name: &str) {
-    check_golden_with(name, cases::compute_render)
+/// As [`check_golden`] for the render case `name`: built-in scene `scene` in mode `S`.
+pub fn check_render_golden<S: cases::Bits + raykernel::spawn::SpawnScalar>(
+    name: &str,
+    scene: &raykernel::render::scenes::SceneData<'_>,
+) {
+    check_golden_with(name, |_| cases::render_hash::<S>(scene))
 }
 
-fn check_golden_with(name: &str, compute: fn(&str) -> Result<u64, Fail>) {
+fn check_golden_with(name: &str, compute: impl FnOnce(&str) -> Result<u64, Fail>) {
     let want = golden::expected(name);
     defmt::assert!(want.is_some(), "{} missing from kernel_hashes.txt", name);
     match compute(name) {

@@ -424,8 +424,8 @@ mod tests {
         defmt::assert!(tf > 0 && tx > 0 && bf > tf && bx > tx);
         defmt::assert!(bf.max(bx).max(tf).max(tx) < 8 * 1024, "over 8 KB of stack");
     }
-    /// Last test: how much of the stack the whole run used (RAM is 16 KB on every machine, as
-    /// on the micro:bit). Fails when less than 512 bytes stay free, before an overflow would.
+    /// Last test: how much of the stack the whole run used. Fails when less than 512 bytes of
+    /// the target's RAM stay free, before an overflow would.
     #[test]
     fn stack_headroom_of_the_whole_run() {
         let top = stack::stack_top();

@@ -1,0 +1,52 @@
+//! On-target renders in fixed point (defmt-test under QEMU): every built-in scene, rendered row by
+//! row and hashed, must equal the host's golden hash (`tests/golden/kernel_hashes.txt`); and
+//! the stack a render uses. One binary per mode: both modes and every accelerator of the
+//! renderer do not fit the 256 KB of flash of the smaller machines in one binary.
+#![no_std]
+#![no_main]
+
+use cortex_m_rt as _;
+use defmt_semihosting as _;
+use panic_probe as _;
+
+use raykernel::render::scenes;
+use raykernel::I16F16;
+use raykernel_qemu::{cases, check_render_golden, stack};
+
+#[defmt::panic_handler]
+fn defmt_panic() -> ! {
+    panic_probe::hard_fault()
+}
+
+/// The default handler spins, so QEMU would hang until the runner's timeout: exit instead.
+#[cortex_m_rt::exception]
+unsafe fn HardFault(_: &cortex_m_rt::ExceptionFrame) -> ! {
+    semihosting::process::exit(101)
+}
+
+#[defmt_test::tests]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn golden_render_cornell_fixed() {
+        check_render_golden::<I16F16>("render_cornell_fixed", &scenes::CORNELL)
+    }
+    #[test]
+    fn golden_render_spheres_fixed() {
+        check_render_golden::<I16F16>("render_spheres_fixed", &scenes::SPHERES)
+    }
+    #[test]
+    fn golden_render_motion_fixed() {
+        check_render_golden::<I16F16>("render_motion_fixed", &scenes::MOTION)
+    }
+    /// Stack used by a whole render (scene conversion, per-object BVH builds, renderer, one
+    /// row of pixels) of the default scene, printed for the footprint table.
+    #[test]
+    fn render_stack_high_water_mark() {
+        let used = stack::stack_use(|| {
+            defmt::assert!(cases::render_hash::<I16F16>(&scenes::CORNELL).is_ok())
+        });
+        defmt::println!("render stack high-water (fixed): {=usize} B", used);
+    }
+}
