@@ -443,11 +443,19 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
     ) -> Option<SceneHit<S>> {
         let mut best: Option<SceneHit<S>> = None;
         let mut best_t = ray.t_max();
+        let mut shortened: Ray<S>;
         for (i, o) in self.objects().enumerate() {
-            let Ok(r) = ray.with_interval(ray.t_min(), best_t) else {
-                continue;
+            // The ray itself until something is hit, then a copy ending at the closest hit.
+            let r = if best.is_none() {
+                ray
+            } else {
+                let Ok(r) = ray.with_interval(ray.t_min(), best_t) else {
+                    continue;
+                };
+                shortened = r;
+                &shortened
             };
-            let h = Self::query_object(o, &r, time, c, ShapeIndex::intersect).flatten();
+            let h = Self::query_object(o, r, time, c, ShapeIndex::intersect).flatten();
             if let Some(h) = h {
                 let id = o.base.saturating_add(h.prim);
                 if best.is_none_or(|b| closer(h.t, id, best_t, b.hit.prim)) {
@@ -589,9 +597,12 @@ impl<S: SpawnScalar> SurfacePoint<'_, S> {
         match self.prim {
             Prim::Triangle(tri, u, v) => {
                 let local = spawn::offset_origin(tri, u, v, dir_s);
+                if self.shift == [0.0; 3] {
+                    return local;
+                }
                 let want = S::side(&tri.v, &local);
                 let mut world = shifted(local, self.shift, 1.0);
-                if self.shift == [0.0; 3] || want == 0 {
+                if want == 0 {
                     return world;
                 }
                 let n = self.normal;

@@ -22,6 +22,7 @@ mod integrator;
 pub mod sampling;
 mod scene;
 pub mod scenes;
+mod srgb;
 
 pub use geometry::{
     memory_needed, AccelMemory, MemoryNeeded, ObjectSlot, MAX_LIGHTS, SPHERE_SPAWN_FACTOR,
@@ -30,6 +31,7 @@ pub use sampling::SamplerKind;
 pub use scene::{
     Camera, Filter, Item, Light, Material, Object, Problem, Rgb, Scene, SceneError, Settings, Shape,
 };
+pub use srgb::encode_srgb8;
 
 use crate::accel::bvh::BuildOptions;
 use crate::accel::grid::GridOptions;
@@ -162,14 +164,11 @@ pub struct Tile {
 }
 
 impl Tile {
-    /// Image coordinates of the tile's `i`-th pixel in row-major order (an empty tile has no
-    /// pixels; its width is taken as 1 so that nothing divides by zero).
-    const fn pixel_at(self, i: usize) -> (u32, u32) {
-        let (i, width) = (i as u32, if self.width == 0 { 1 } else { self.width });
-        (
-            self.x.wrapping_add(i % width),
-            self.y.wrapping_add(i / width),
-        )
+    /// Image coordinates of the tile's pixels in row-major order.
+    fn pixels(self) -> impl Iterator<Item = (u32, u32)> {
+        let columns = self.x..self.x.saturating_add(self.width);
+        (self.y..self.y.saturating_add(self.height))
+            .flat_map(move |y| columns.clone().map(move |x| (x, y)))
     }
 }
 
@@ -281,8 +280,7 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
     pub fn render_tile(&self, tile: Tile, out: &mut [Rgb]) -> Result<RenderStats, SceneError> {
         let n = self.check_tile(tile, out.len(), 1)?;
         let mut stats = RenderStats::default();
-        for (i, px) in out.iter_mut().take(n).enumerate() {
-            let (x, y) = tile.pixel_at(i);
+        for ((x, y), px) in tile.pixels().zip(out.iter_mut().take(n)) {
             *px = self.pixel(x, y, &mut stats);
         }
         Ok(stats)
@@ -295,8 +293,7 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
     pub fn render_tile_srgb8(&self, tile: Tile, out: &mut [u8]) -> Result<RenderStats, SceneError> {
         let n = self.check_tile(tile, out.len(), 3)?;
         let mut stats = RenderStats::default();
-        for (i, px) in out.chunks_exact_mut(3).take(n).enumerate() {
-            let (x, y) = tile.pixel_at(i);
+        for ((x, y), px) in tile.pixels().zip(out.chunks_exact_mut(3).take(n)) {
             let c = self.pixel(x, y, &mut stats);
             for (b, v) in px.iter_mut().zip(c) {
                 *b = encode_srgb8(v);
@@ -354,20 +351,6 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
         }
         Ok(n)
     }
-}
-
-/// Linear `[0, 1]` to 8-bit sRGB (IEC 61966-2-1 transfer function), rounded to nearest;
-/// values outside `[0, 1]` (and NaN) clip.
-#[must_use]
-pub fn encode_srgb8(linear: f32) -> u8 {
-    let c = if linear > 0.0 { linear } else { 0.0 };
-    let c = if c < 1.0 { c } else { 1.0 };
-    let s = if c <= 0.003_130_8 {
-        12.92 * c
-    } else {
-        1.055 * libm::powf(c, 1.0 / 2.4) - 0.055
-    };
-    (s * 255.0 + 0.5) as u8
 }
 
 fn check_settings(s: &Settings) -> Result<(), SceneError> {
