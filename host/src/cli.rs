@@ -363,6 +363,13 @@ pub struct BenchArgs {
     /// Rays per set in the scale sweep [default: 262144, or 16384 with --quick].
     #[arg(long, value_name = "N", value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
     pub scale_rays: Option<usize>,
+    /// Skip the image-convergence renders (RMSE against time per sampler).
+    #[arg(long)]
+    pub no_images: bool,
+    /// Largest sample count of the image renders (1, 2, 4, … up to it; the reference uses 16
+    /// times as many) [default: 256, or 16 with --quick].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub image_spp: Option<u32>,
 }
 
 /// The JSON report of `host bench`: where the files went, and the run's size.
@@ -720,6 +727,10 @@ pub fn run_bench(args: &BenchArgs) -> Result<BenchReport, Error> {
                 .unwrap_or(if args.quick { 1 << 14 } else { 1 << 18 }),
             runs: args.runs.unwrap_or(if args.quick { 1 } else { 3 }),
         },
+        images: (!args.no_images).then(|| {
+            let threads = std::thread::available_parallelism().map_or(1, usize::from);
+            crate::bench::images::ImageOptions::new(args.quick, args.image_spp, threads)
+        }),
         quick: args.quick,
         command: bench_command(),
     };

@@ -34,6 +34,7 @@ fn run_bench(scenes: &Path, out: &Path, extra: &[&str]) -> std::process::Output 
         .args(["--scene", "ball", "--scene", "fine"])
         .args(["--rust-rays", "--rays-per-set", "1024", "--runs", "1"])
         .args(["--scale", "500,2000", "--scale-rays", "256"])
+        .args(["--image-spp", "4"])
         .arg("--out")
         .arg(out)
         .args(extra)
@@ -126,7 +127,15 @@ fn bench_writes_a_well_formed_report_csv_json_and_plots() {
         count += 1;
     }
     assert!(count > 100, "only {count} figures");
-    for s in ["traversal", "peer", "agreement", "accuracy", "scale", "fit"] {
+    for s in [
+        "traversal",
+        "peer",
+        "agreement",
+        "accuracy",
+        "scale",
+        "images",
+        "fit",
+    ] {
         assert!(sections.contains(s), "no {s} figures in the CSV");
     }
 
@@ -153,6 +162,21 @@ fn bench_writes_a_well_formed_report_csv_json_and_plots() {
     assert_eq!(scale.len(), 4);
     assert!(scale[0]["triangles"].as_u64().unwrap() >= 500);
 
+    // Images: three samplers at 1, 2 and 4 spp; more samples, less error (the renders are
+    // deterministic, so this is a fixed fact of this scene, not a chance).
+    let images = json["images"].as_array().unwrap();
+    assert_eq!(images.len(), 3 * 3);
+    for sampler in ["independent", "stratified", "sobol"] {
+        let rmse = |spp: u64| {
+            images
+                .iter()
+                .find(|r| r["sampler"] == sampler && r["spp"] == spp)
+                .and_then(|r| r["rmse"].as_f64())
+                .unwrap()
+        };
+        assert!(rmse(4) < rmse(1) && rmse(1) > 0.0, "{sampler}");
+    }
+
     // Plots: PNG files.
     for plot in [
         "speed_primary",
@@ -161,6 +185,7 @@ fn bench_writes_a_well_formed_report_csv_json_and_plots() {
         "error_vs_speed_incoherent",
         "scale_build",
         "scale_trace",
+        "images_error_vs_time",
     ] {
         let bytes = std::fs::read(out.join("plots").join(format!("{plot}.png"))).unwrap();
         assert!(

@@ -6,12 +6,14 @@
 //! - [`peers`]: `obvhs` (BVH2, CWBVH) and `bvh`, measured in the same run,
 //! - [`accuracy`]: the `f64` reference and each contender's hit-distance error,
 //! - [`scale`]: the tiled scene from 10k to 1M+ triangles,
+//! - [`images`]: the renderer's image error against time, per sampler,
 //! - [`report`], [`plot`], [`stats`]: Markdown, CSV, JSON and PNG output,
 //! - [`machine`]: the machine line.
 //!
 //! Everything is single-threaded except the untimed `f64` reference.
 
 pub mod accuracy;
+pub mod images;
 pub mod machine;
 pub mod mt;
 pub mod ours;
@@ -49,6 +51,8 @@ pub struct BenchConfig {
     pub peers: bool,
     /// The tiled-scene sweep (empty sizes: skipped).
     pub scale: scale::ScaleOptions,
+    /// The image-convergence renders (`None`: skipped).
+    pub images: Option<images::ImageOptions>,
     /// `--quick` (noted in the report).
     pub quick: bool,
     /// The command line, for the report.
@@ -122,6 +126,10 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
         let meshes: Vec<&crate::obj::Mesh> = scenes.iter().map(|s| &s.mesh).collect();
         scale::run(&meshes, &config.scale)?
     };
+    let image_rows = match &config.images {
+        Some(opts) => images::run(opts)?,
+        None => Vec::new(),
+    };
     machine.load_end = machine::load_average();
     let mut results = BenchResults {
         machine,
@@ -140,6 +148,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
         rows,
         reference: references,
         scale: scale_rows,
+        images: image_rows,
         slopes: Vec::new(),
         elapsed_s: 0.0,
     };
