@@ -637,13 +637,16 @@ pub fn images_section(r: &BenchResults) -> String {
     );
     let _ = writeln!(
         s,
-        "| sampler | spp | seconds | RMSE |\n|---|---:|---:|---:|"
+        "| sampler | spp | render ms | RMSE |\n|---|---:|---:|---:|"
     );
     for x in &r.images {
         let _ = writeln!(
             s,
-            "| {} | {} | {:.3} | {:.5} |",
-            x.sampler, x.spp, x.seconds, x.rmse
+            "| {} | {} | {:.2} | {:.5} |",
+            x.sampler,
+            x.spp,
+            x.seconds * 1e3,
+            x.rmse
         );
     }
     let _ = writeln!(
