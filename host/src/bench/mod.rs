@@ -7,6 +7,7 @@
 //! - [`accuracy`]: the `f64` reference and each contender's hit-distance error,
 //! - [`scale`]: the tiled scene from 10k to 1M+ triangles,
 //! - [`images`]: the renderer's image error against time, per sampler,
+//! - [`overhead`]: the renderer against hand-written casters (the render plan's cost),
 //! - [`report`], [`plot`], [`stats`]: Markdown, CSV, JSON and PNG output,
 //! - [`machine`]: the machine line.
 //!
@@ -17,6 +18,7 @@ pub mod images;
 pub mod machine;
 pub mod mt;
 pub mod ours;
+pub mod overhead;
 pub mod peers;
 pub mod plot;
 pub mod report;
@@ -126,6 +128,8 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
         let meshes: Vec<&crate::obj::Mesh> = scenes.iter().map(|s| &s.mesh).collect();
         scale::run(&meshes, &config.scale)?
     };
+    eprintln!("bench: render overhead");
+    let overhead_rows = overhead::run(if config.quick { 3 } else { 15 });
     let image_rows = match &config.images {
         Some(opts) => images::run(opts)?,
         None => Vec::new(),
@@ -149,6 +153,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
         reference: references,
         scale: scale_rows,
         images: image_rows,
+        overhead: overhead_rows,
         slopes: Vec::new(),
         elapsed_s: 0.0,
     };

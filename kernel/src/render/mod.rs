@@ -269,7 +269,12 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
             let mut stream = self.sampler.stream(index, k);
             sum += integrator::sample_radiance(self, x, y, &mut stream, stats);
         }
-        (sum / spp as f32).to_array()
+        // One sample: the mean is the sample (x / 1 is x, bit for bit).
+        if spp == 1 {
+            sum.to_array()
+        } else {
+            (sum / spp as f32).to_array()
+        }
     }
 
     /// Renders `tile` as linear RGB into `out` (row-major within the tile, `width·height`
