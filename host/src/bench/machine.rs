@@ -1,4 +1,5 @@
-//! The machine line at the top of the report: CPU model, cores, compiler, profile, load.
+//! The machine line at the top of the report: CPU model, cores, compiler, profile, load, and
+//! how much CPU other processes took during the run.
 
 use serde::Serialize;
 use std::process::Command;
@@ -18,6 +19,13 @@ pub struct Machine {
     pub load_start: Option<f64>,
     /// 1-minute load average at the end.
     pub load_end: Option<f64>,
+    /// Cores' worth of CPU time other processes used during the run (all busy time in
+    /// /proc/stat minus this process's, over the wall time); `None` where /proc is missing.
+    /// Unlike the load average it does not count tasks waiting on I/O.
+    pub others_cores: Option<f64>,
+    /// CPU counters at the start, for `others_cores`.
+    #[serde(skip)]
+    start: Option<CpuCounters>,
     /// UTC date of the run, `YYYY-MM-DD`.
     pub date: String,
     /// `git rev-parse --short HEAD` of the working directory, when available.
@@ -55,9 +63,20 @@ impl Machine {
             },
             load_start: load_average(),
             load_end: None,
+            others_cores: None,
+            start: CpuCounters::read(),
             date: utc_date(),
             commit,
         }
+    }
+
+    /// Records the end of the run: load average and other processes' CPU use.
+    pub fn finish(&mut self) {
+        self.load_end = load_average();
+        self.others_cores = self
+            .start
+            .zip(CpuCounters::read())
+            .and_then(|(a, b)| b.others_since(&a));
     }
 
     /// One line: `machine: CPU, N cores; rustc ...; release profile`.
@@ -67,6 +86,53 @@ impl Machine {
             "machine: {}, {} cores; {}; {} profile",
             self.cpu, self.cores, self.rustc, self.profile
         )
+    }
+}
+
+/// Busy time of every CPU and of this process, in clock ticks, and when they were read.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct CpuCounters {
+    all_busy: u64,
+    own: u64,
+    at: std::time::Instant,
+}
+
+impl CpuCounters {
+    /// `/proc/stat`'s first line (user, nice, system, irq, softirq, steal; not idle or iowait)
+    /// and `/proc/self/stat`'s utime + stime (every thread of this process).
+    fn read() -> Option<Self> {
+        let stat = std::fs::read_to_string("/proc/stat").ok()?;
+        let cpu: Vec<u64> = stat
+            .lines()
+            .next()?
+            .split_whitespace()
+            .skip(1)
+            .filter_map(|x| x.parse().ok())
+            .collect();
+        let field = |i: usize| cpu.get(i).copied().unwrap_or(0);
+        let all_busy = field(0) + field(1) + field(2) + field(5) + field(6) + field(7);
+        let own_stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+        // Fields after the command name (which may hold spaces) start at `state`: utime and
+        // stime are the 12th and 13th of those.
+        let rest = own_stat.rsplit_once(')')?.1;
+        let mut fields = rest.split_whitespace().skip(11);
+        let utime: u64 = fields.next()?.parse().ok()?;
+        let stime: u64 = fields.next()?.parse().ok()?;
+        Some(Self {
+            all_busy,
+            own: utime + stime,
+            at: std::time::Instant::now(),
+        })
+    }
+
+    /// Cores' worth of CPU other processes used between `start` and `self`.
+    fn others_since(&self, start: &Self) -> Option<f64> {
+        // Both counters tick at USER_HZ, 100 per second on Linux.
+        const TICKS_PER_S: f64 = 100.0;
+        let wall = self.at.duration_since(start.at).as_secs_f64();
+        let busy = self.all_busy.checked_sub(start.all_busy)? as f64;
+        let own = self.own.checked_sub(start.own)? as f64;
+        (wall > 0.0).then(|| ((busy - own) / TICKS_PER_S / wall).max(0.0))
     }
 }
 

@@ -134,7 +134,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
         Some(opts) => images::run(opts)?,
         None => Vec::new(),
     };
-    machine.load_end = machine::load_average();
+    machine.finish();
     let mut results = BenchResults {
         machine,
         command: config.command.clone(),

@@ -367,16 +367,21 @@ pub fn markdown(r: &BenchResults) -> String {
         r.elapsed_s
     );
     let load = |l: Option<f64>| l.map_or_else(|| "unknown".into(), |v| format!("{v:.2}"));
+    let others = m.others_cores;
     let _ = writeln!(
         s,
-        "- load average (1 min) at start / end: {} / {}{}",
+        "- other processes used {} of CPU during the run (busy time in /proc/stat minus this \
+         process's); load average (1 min, counts tasks waiting on I/O too) at start / end: \
+         {} / {}{}",
+        others.map_or_else(|| "unknown".into(), |c| format!("{c:.2} cores")),
         load(m.load_start),
         load(m.load_end),
-        if m.load_start.unwrap_or(0.0).max(m.load_end.unwrap_or(0.0)) > 0.5 {
-            " — other processes were using the cores, so times are noisy; rerun on a quiet \
+        // The timed work is single-threaded: it needs one core to itself.
+        if others.is_some_and(|c| c > m.cores as f64 - 1.0 + 0.2) {
+            " — they left less than one core free, so times are noisy; rerun on a quieter \
              machine for figures to quote"
         } else {
-            ""
+            " — at least one core stayed free for the single-threaded timed work"
         }
     );
     let _ = writeln!(
