@@ -6,7 +6,7 @@
 //! as the kernel's single-threaded [`Renderer::render_srgb8`] (`host check` proves it).
 
 use crate::error::Error;
-use crate::trace::{AccelKind, Mode};
+use crate::trace::{AccelKind, Mode, NodeArena};
 use indicatif::{ProgressBar, ProgressStyle};
 use raykernel::bvh::BuildOptions;
 use raykernel::geom::spawn::SpawnScalar;
@@ -15,7 +15,7 @@ use raykernel::render::{
     encode_srgb8, memory_needed, AccelChoice, AccelMemory, Object, ObjectSlot, RenderPlan,
     RenderStats, Renderer, Rgb, SceneError, Settings, Shape, Tile,
 };
-use raykernel::{GridOptions, KdNode, KdOptions, Node, Scalar, Sphere, Triangle, I16F16};
+use raykernel::{GridOptions, KdNode, KdOptions, Scalar, Sphere, Triangle, I16F16};
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::Path;
@@ -158,12 +158,13 @@ pub fn with_renderer<S: SpawnScalar, R>(
     let scene = data.scene(&triangles, &spheres, &mut objects)?;
     let need = memory_needed(scene.objects, accel);
     let mut slots = vec![ObjectSlot::EMPTY; need.objects];
-    let mut bvh_nodes = vec![Node::<S>::EMPTY; need.bvh_nodes];
+    // 64-byte aligned, a sibling pair per cache line, as the kernel's layout intends.
+    let mut bvh_nodes = NodeArena::<S>::with_slots(need.bvh_nodes);
     let mut kd_nodes = vec![KdNode::<S>::EMPTY; need.kd_nodes];
     let mut words = vec![0u32; need.words];
     let memory = AccelMemory {
         objects: &mut slots,
-        bvh_nodes: &mut bvh_nodes,
+        bvh_nodes: bvh_nodes.slots(),
         kd_nodes: &mut kd_nodes,
         words: &mut words,
     };

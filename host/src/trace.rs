@@ -429,9 +429,9 @@ impl<S: Scalar> NodeArena<S> {
     #[must_use]
     pub fn for_accel<P: Primitive<S>>(accel: AccelKind, prims: &[P]) -> Self {
         let n = prims.len();
-        let mut arena = Self::new(0);
+        let mut arena = Self::with_slots(0);
         match accel {
-            AccelKind::Bvh => arena = Self::new(nodes_needed(n)),
+            AccelKind::Bvh => arena = Self::with_slots(nodes_needed(n)),
             AccelKind::Linear => {}
             AccelKind::Grid => {
                 if let Ok(size) = Grid::size_for(prims, GridOptions::default()) {
@@ -447,7 +447,9 @@ impl<S: Scalar> NodeArena<S> {
         arena
     }
 
-    fn new(slots: usize) -> Self {
+    /// `slots` BVH nodes (and no grid or kd-tree memory).
+    #[must_use]
+    pub fn with_slots(slots: usize) -> Self {
         // One spare slot: `Node` is 32-aligned, so skipping at most one reaches a 64-byte line.
         Self {
             nodes: vec![Node::EMPTY; slots + 1],
@@ -458,7 +460,7 @@ impl<S: Scalar> NodeArena<S> {
     }
 
     /// The `slots` requested, starting on a 64-byte boundary.
-    fn slots(&mut self) -> &mut [Node<S>] {
+    pub fn slots(&mut self) -> &mut [Node<S>] {
         let misaligned = !(self.nodes.as_ptr() as usize).is_multiple_of(Self::LINE);
         let skip = usize::from(misaligned);
         let len = self.nodes.len() - 1;
