@@ -129,7 +129,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
         scale::run(&meshes, &config.scale)?
     };
     eprintln!("bench: render overhead");
-    let overhead_rows = overhead::run(if config.quick { 3 } else { 15 });
+    let overhead_rows = overhead::run(if config.quick { 3 } else { 31 });
     let image_rows = match &config.images {
         Some(opts) => images::run(opts)?,
         None => Vec::new(),
