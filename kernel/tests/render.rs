@@ -827,7 +827,7 @@ fn buffers_and_tiles_are_checked_exactly() {
     // One element short in each buffer: a typed error naming it, with the exact sizes.
     for (accel, n) in [(bvh, bvh_need), (kd, kd_need), (grid, grid_need)] {
         let shorts = [
-            ("object_slots", 2, MemoryNeeded { objects: 1, ..n }),
+            ("objects", 2, MemoryNeeded { objects: 1, ..n }),
             (
                 "bvh_nodes",
                 n.bvh_nodes,

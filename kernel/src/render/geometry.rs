@@ -334,7 +334,7 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
         }
         let need = memory_needed(objects, choice);
         for (field, needed, available) in [
-            ("object_slots", need.objects, memory.objects.len()),
+            ("objects", need.objects, memory.objects.len()),
             ("bvh_nodes", need.bvh_nodes, memory.bvh_nodes.len()),
             ("kd_nodes", need.kd_nodes, memory.kd_nodes.len()),
             ("words", need.words, memory.words.len()),
