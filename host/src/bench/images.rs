@@ -64,15 +64,6 @@ pub struct ImageRow {
     pub reference_spp: u32,
 }
 
-/// Sampler names as on the command line.
-pub fn sampler_name(kind: SamplerKind) -> &'static str {
-    match kind {
-        SamplerKind::Independent => "independent",
-        SamplerKind::Stratified => "stratified",
-        SamplerKind::Sobol => "sobol",
-    }
-}
-
 /// Renders the reference, then every sampler at every sample count.
 ///
 /// # Errors
@@ -108,16 +99,12 @@ pub fn run(opts: &ImageOptions) -> Result<Vec<ImageRow>, Error> {
         opts.threads,
     )?;
     let mut rows = Vec::new();
-    for sampler in [
-        SamplerKind::Independent,
-        SamplerKind::Stratified,
-        SamplerKind::Sobol,
-    ] {
+    for sampler in SamplerKind::ALL {
         for &spp in &opts.spps {
             let r = go(settings(sampler, spp), 1)?;
             rows.push(ImageRow {
                 scene: opts.scene.into(),
-                sampler: sampler_name(sampler).into(),
+                sampler: sampler.name().into(),
                 spp,
                 seconds: r.render_ms / 1e3,
                 rmse: rmse(&reference.frame.linear, &r.frame.linear),

@@ -131,45 +131,37 @@ trait ObvhsQueries {
     fn bytes(&self) -> usize;
 }
 
-impl ObvhsQueries for obvhs::bvh2::Bvh2 {
-    fn closest<F: FnMut(&obvhs::ray::Ray, usize) -> f32>(
-        &self,
-        ray: obvhs::ray::Ray,
-        hit: &mut obvhs::ray::RayHit,
-        f: F,
-    ) -> bool {
-        self.ray_traverse(ray, hit, f)
-    }
-    fn miss<F: FnMut(&obvhs::ray::Ray, usize) -> f32>(&self, ray: obvhs::ray::Ray, f: F) -> bool {
-        self.ray_traverse_miss(ray, f)
-    }
-    fn ids(&self) -> &[u32] {
-        &self.primitive_indices
-    }
-    fn bytes(&self) -> usize {
-        std::mem::size_of_val(&self.nodes[..]) + std::mem::size_of_val(&self.primitive_indices[..])
-    }
+/// Both obvhs layouts answer the same calls under the same names.
+macro_rules! obvhs_queries {
+    ($($layout:ty),*) => {$(
+        impl ObvhsQueries for $layout {
+            fn closest<F: FnMut(&obvhs::ray::Ray, usize) -> f32>(
+                &self,
+                ray: obvhs::ray::Ray,
+                hit: &mut obvhs::ray::RayHit,
+                f: F,
+            ) -> bool {
+                self.ray_traverse(ray, hit, f)
+            }
+            fn miss<F: FnMut(&obvhs::ray::Ray, usize) -> f32>(
+                &self,
+                ray: obvhs::ray::Ray,
+                f: F,
+            ) -> bool {
+                self.ray_traverse_miss(ray, f)
+            }
+            fn ids(&self) -> &[u32] {
+                &self.primitive_indices
+            }
+            fn bytes(&self) -> usize {
+                std::mem::size_of_val(&self.nodes[..])
+                    + std::mem::size_of_val(&self.primitive_indices[..])
+            }
+        }
+    )*};
 }
 
-impl ObvhsQueries for obvhs::cwbvh::CwBvh {
-    fn closest<F: FnMut(&obvhs::ray::Ray, usize) -> f32>(
-        &self,
-        ray: obvhs::ray::Ray,
-        hit: &mut obvhs::ray::RayHit,
-        f: F,
-    ) -> bool {
-        self.ray_traverse(ray, hit, f)
-    }
-    fn miss<F: FnMut(&obvhs::ray::Ray, usize) -> f32>(&self, ray: obvhs::ray::Ray, f: F) -> bool {
-        self.ray_traverse_miss(ray, f)
-    }
-    fn ids(&self) -> &[u32] {
-        &self.primitive_indices
-    }
-    fn bytes(&self) -> usize {
-        std::mem::size_of_val(&self.nodes[..]) + std::mem::size_of_val(&self.primitive_indices[..])
-    }
-}
+obvhs_queries!(obvhs::bvh2::Bvh2, obvhs::cwbvh::CwBvh);
 
 fn obvhs_run(
     peer: Peer,

@@ -264,20 +264,14 @@ fn draw_plots(results: &mut BenchResults, dir: &Path) -> Result<Vec<PathBuf>, Er
     }
     if !results.images.is_empty() {
         let path = dir.join("images_error_vs_time.png");
-        let mut samplers: Vec<&str> = Vec::new();
-        for r in &results.images {
-            if !samplers.contains(&r.sampler.as_str()) {
-                samplers.push(&r.sampler);
-            }
-        }
-        let series: Vec<Series> = samplers
+        let series: Vec<Series> = raykernel::render::SamplerKind::ALL
             .iter()
-            .map(|s| Series {
-                name: (*s).to_string(),
+            .map(|k| Series {
+                name: k.name().to_string(),
                 points: results
                     .images
                     .iter()
-                    .filter(|r| r.sampler == *s && r.seconds > 0.0 && r.rmse > 0.0)
+                    .filter(|r| r.sampler == k.name() && r.seconds > 0.0 && r.rmse > 0.0)
                     .map(|r| (r.seconds, r.rmse))
                     .collect(),
             })

@@ -443,19 +443,11 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
     ) -> Option<SceneHit<S>> {
         let mut best: Option<SceneHit<S>> = None;
         let mut best_t = ray.t_max();
-        let mut shortened: Ray<S>;
         for (i, o) in self.objects().enumerate() {
-            // The ray itself until something is hit, then a copy ending at the closest hit.
-            let r = if best.is_none() {
-                ray
-            } else {
-                let Ok(r) = ray.with_interval(ray.t_min(), best_t) else {
-                    continue;
-                };
-                shortened = r;
-                &shortened
+            let Ok(r) = ray.with_interval(ray.t_min(), best_t) else {
+                continue;
             };
-            let h = Self::query_object(o, r, time, c, ShapeIndex::intersect).flatten();
+            let h = Self::query_object(o, &r, time, c, ShapeIndex::intersect).flatten();
             if let Some(h) = h {
                 let id = o.base.saturating_add(h.prim);
                 if best.is_none_or(|b| closer(h.t, id, best_t, b.hit.prim)) {
