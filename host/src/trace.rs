@@ -542,7 +542,8 @@ pub fn trace_closest<S: Scalar, A: Accel<S>>(
     let mut hits = vec![HitRecord::MISS; prepared.rays.len()];
     let start = Instant::now();
     for (slot, ray) in hits.iter_mut().zip(&prepared.rays) {
-        if let Some(h) = accel.intersect(ray) {
+        // A hit record holds t and the primitive: no barycentrics needed.
+        if let Some(h) = accel.nearest(ray) {
             *slot = HitRecord {
                 t: h.t.to_f32(),
                 prim: h.prim,

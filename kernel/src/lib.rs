@@ -42,7 +42,7 @@ pub mod scalar;
 pub use accel::bvh::{self, Bvh, Node};
 pub use accel::grid::{self, Grid, GridOptions};
 pub use accel::kdtree::{self, KdNode, KdOptions, KdTree};
-pub use accel::{Accel, Counters, Linear, NoStats, TraversalStats};
+pub use accel::{Accel, Counters, Linear, Nearest, NoStats, TraversalStats};
 pub use error::{Arena, BuildError, PointError, RayError};
 pub use geom::{spawn, Aabb, Hit, Primitive, Ray, Sphere, Triangle};
 pub use glam;

@@ -1,5 +1,5 @@
-use super::{Accel, Counters};
-use crate::geom::{closer, Hit, Primitive, Ray};
+use super::{Accel, Counters, Nearest};
+use crate::geom::{closer, Primitive, Ray};
 use crate::scalar::Scalar;
 use core::marker::PhantomData;
 
@@ -21,27 +21,29 @@ impl<'a, S: Scalar, P: Primitive<S>> Linear<'a, S, P> {
 }
 
 impl<S: Scalar, P: Primitive<S>> Accel<S> for Linear<'_, S, P> {
-    fn intersect_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Hit<S>> {
+    fn nearest_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Nearest<S>> {
         let (t_min, mut best_t) = (ray.t_min(), ray.t_max());
-        let mut best: Option<(u32, &P)> = None;
+        let mut best: Option<u32> = None;
         for (id, prim) in (0u32..).zip(self.prims) {
             stats.prim();
             if let Some(t) = prim.hit_t(ray.data(), t_min, best_t) {
-                if best.is_none_or(|(b, _)| closer(t, id, best_t, b)) {
+                if best.is_none_or(|b| closer(t, id, best_t, b)) {
                     best_t = t;
-                    best = Some((id, prim));
+                    best = Some(id);
                 }
             }
         }
-        best.map(|(prim, p)| {
-            let (u, v) = p.hit_uv(ray.data());
-            Hit {
-                t: best_t,
-                prim,
-                u,
-                v,
-            }
+        best.map(|prim| Nearest {
+            t: best_t,
+            prim,
+            slot: prim as usize,
         })
+    }
+
+    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
+        self.prims
+            .get(found.slot)
+            .map_or((S::ZERO, S::ZERO), |p| p.hit_uv(ray.data()))
     }
 
     fn occluded_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> bool {

@@ -53,16 +53,51 @@ impl Counters for TraversalStats {
     }
 }
 
+/// What a closest-hit traversal found, before barycentrics: distance and primitive id, plus
+/// where the primitive sits in the accelerator's storage (for [`Accel::barycentrics`]).
+///
+/// Callers that need only `t` and the id (hit files, emitters, occlusion-like shading) stop
+/// here; [`Accel::intersect`] adds the barycentrics.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Nearest<S: Scalar> {
+    /// Distance along the ray.
+    pub t: S,
+    /// Id (index in the caller's primitive slice) of the primitive hit.
+    pub prim: u32,
+    /// Index of that primitive in the accelerator's primitive storage.
+    pub(crate) slot: usize,
+}
+
 /// The query API every accelerator offers.
 ///
-/// `intersect` is the closest hit; ties at equal `t` go to the lowest primitive id, so every
-/// accelerator returns the same [`Hit`]. `occluded` is any hit in `[t_min, t_max]` (early exit).
+/// `nearest` is the closest hit; ties at equal `t` go to the lowest primitive id, so every
+/// accelerator returns the same [`Nearest`] and the same [`Hit`]. `occluded` is any hit in
+/// `[t_min, t_max]` (early exit).
 pub trait Accel<S: Scalar> {
-    /// Closest hit, counting work in `stats`.
-    fn intersect_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Hit<S>>;
+    /// Closest hit's distance and primitive, counting work in `stats`.
+    fn nearest_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Nearest<S>>;
     /// Any hit, counting work in `stats`.
     fn occluded_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> bool;
+    /// Barycentrics of a hit `nearest` returned for `ray` (zero for primitives without them).
+    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S);
 
+    /// Closest hit with barycentrics, counting work in `stats`.
+    #[inline]
+    fn intersect_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Hit<S>> {
+        let found = self.nearest_counted(ray, stats)?;
+        let (u, v) = self.barycentrics(ray, &found);
+        Some(Hit {
+            t: found.t,
+            prim: found.prim,
+            u,
+            v,
+        })
+    }
+    /// Closest hit's distance and primitive.
+    #[inline]
+    fn nearest(&self, ray: &Ray<S>) -> Option<Nearest<S>> {
+        self.nearest_counted(ray, &mut NoStats)
+    }
     /// Closest hit.
     #[inline]
     fn intersect(&self, ray: &Ray<S>) -> Option<Hit<S>> {

@@ -17,10 +17,10 @@ use super::{AccelChoice, SceneError};
 use crate::accel::bvh::{self, Bvh, Node};
 use crate::accel::grid::Grid;
 use crate::accel::kdtree::{self, KdNode, KdTree};
-use crate::accel::{Accel, Counters, Linear};
+use crate::accel::{Accel, Counters, Linear, Nearest};
 use crate::error::BuildError;
 use crate::geom::spawn::{self, cross, sub, unit, SpawnScalar, MAX_NUDGES};
-use crate::geom::{closer, Aabb, Hit, Primitive, Ray, Sphere, Triangle};
+use crate::geom::{closer, Aabb, Primitive, Ray, Sphere, Triangle};
 use crate::render::scene::{Item, Light, Problem};
 use crate::scalar::Scalar;
 
@@ -42,12 +42,12 @@ enum Index<'a, S: Scalar, P: Primitive<S>> {
 
 impl<S: Scalar, P: Primitive<S>> Index<'_, S, P> {
     #[inline]
-    fn intersect<C: Counters>(&self, ray: &Ray<S>, c: &mut C) -> Option<Hit<S>> {
+    fn nearest<C: Counters>(&self, ray: &Ray<S>, c: &mut C) -> Option<Nearest<S>> {
         match self {
-            Self::Linear(a) => a.intersect_counted(ray, c),
-            Self::Bvh(a) => a.intersect_counted(ray, c),
-            Self::Grid(a) => a.intersect_counted(ray, c),
-            Self::KdTree(a) => a.intersect_counted(ray, c),
+            Self::Linear(a) => a.nearest_counted(ray, c),
+            Self::Bvh(a) => a.nearest_counted(ray, c),
+            Self::Grid(a) => a.nearest_counted(ray, c),
+            Self::KdTree(a) => a.nearest_counted(ray, c),
         }
     }
     #[inline]
@@ -214,10 +214,10 @@ enum ShapeIndex<'a, S: Scalar> {
 
 impl<S: Scalar> ShapeIndex<'_, S> {
     #[inline]
-    fn intersect<C: Counters>(&self, ray: &Ray<S>, c: &mut C) -> Option<Hit<S>> {
+    fn nearest<C: Counters>(&self, ray: &Ray<S>, c: &mut C) -> Option<Nearest<S>> {
         match self {
-            Self::Triangles(a) => a.intersect(ray, c),
-            Self::Spheres(a) => a.intersect(ray, c),
+            Self::Triangles(a) => a.nearest(ray, c),
+            Self::Spheres(a) => a.nearest(ray, c),
         }
     }
     #[inline]
@@ -282,10 +282,14 @@ pub(crate) enum Surface {
     Light { light: usize },
 }
 
-/// A closest hit over the whole scene.
+/// A closest hit over the whole scene. Barycentrics are not computed here: only shading a
+/// surface point needs them ([`Geometry::surface_point`]).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct SceneHit<S: Scalar> {
-    pub(crate) hit: Hit<S>,
+    /// Distance along the ray.
+    pub(crate) t: S,
+    /// Global primitive id (the tie rule's key).
+    pub(crate) prim: u32,
     pub(crate) surface: Surface,
 }
 
@@ -413,12 +417,7 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
         };
         c.node();
         o.swept.slab(ray)?;
-        let origin = shifted(
-            S::vec_to_array(ray.origin()),
-            displacement::<S>(m, time),
-            -1.0,
-        );
-        let moved = ray.moved(origin).ok()?;
+        let moved = moved_into_frame::<S>(m, ray, time)?;
         Some(query(&o.index, &moved, c))
     }
 
@@ -444,16 +443,24 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
         let mut best: Option<SceneHit<S>> = None;
         let mut best_t = ray.t_max();
         for (i, o) in self.objects().enumerate() {
-            let Ok(r) = ray.with_interval(ray.t_min(), best_t) else {
-                continue;
+            // Until something is hit the ray's own interval applies: no copy of the ray (a
+            // fresh ray copied whole stalls on store forwarding, measurably per camera ray).
+            let h = if best.is_none() {
+                Self::query_object(o, ray, time, c, ShapeIndex::nearest)
+            } else {
+                let Ok(r) = ray.with_interval(ray.t_min(), best_t) else {
+                    continue;
+                };
+                Self::query_object(o, &r, time, c, ShapeIndex::nearest)
             };
-            let h = Self::query_object(o, &r, time, c, ShapeIndex::intersect).flatten();
+            let h = h.flatten();
             if let Some(h) = h {
                 let id = o.base.saturating_add(h.prim);
-                if best.is_none_or(|b| closer(h.t, id, best_t, b.hit.prim)) {
+                if best.is_none_or(|b| closer(h.t, id, best_t, b.prim)) {
                     best_t = h.t;
                     best = Some(SceneHit {
-                        hit: Hit { prim: id, ..h },
+                        t: h.t,
+                        prim: id,
                         surface: Surface::Object {
                             object: i,
                             local: h.prim,
@@ -479,15 +486,11 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
                 LightGeom::Sphere(s) => s.hit_t(ray.data(), ray.t_min(), best_t),
             };
             if let Some(t) = t {
-                if best.is_none_or(|b| closer(t, id, best_t, b.hit.prim)) {
+                if best.is_none_or(|b| closer(t, id, best_t, b.prim)) {
                     best_t = t;
                     best = Some(SceneHit {
-                        hit: Hit {
-                            t,
-                            prim: id,
-                            u: S::ZERO,
-                            v: S::ZERO,
-                        },
+                        t,
+                        prim: id,
                         surface: Surface::Light { light: i },
                     });
                 }
@@ -518,8 +521,13 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
         match o.shape {
             Shape::Triangles(t) => {
                 let tri = t.get(local as usize)?;
+                // Barycentrics as the accelerator gives them: from the ray in the object's frame.
+                let (hu, hv) = match o.motion {
+                    None => tri.hit_uv(ray.data()),
+                    Some(m) => tri.hit_uv(moved_into_frame::<S>(m, ray, time)?.data()),
+                };
                 let v = tri.v.map(|p| p.map(S::to_f64));
-                let (u, w) = (h.hit.u.to_f64(), h.hit.v.to_f64());
+                let (u, w) = (hu.to_f64(), hv.to_f64());
                 let p: [f64; 3] = core::array::from_fn(|k| {
                     v[0][k] + u * (v[1][k] - v[0][k]) + w * (v[2][k] - v[0][k]) + d[k]
                 });
@@ -528,7 +536,7 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
                 Some(SurfacePoint {
                     position: p,
                     normal: n.map(|x| x as f32),
-                    prim: Prim::Triangle(tri, h.hit.u, h.hit.v),
+                    prim: Prim::Triangle(tri, hu, hv),
                     shift: d,
                 })
             }
@@ -538,7 +546,7 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
                 // The hit point from the ray in the object's frame, then shifted back.
                 let o3 = S::vec_to_array(ray.origin()).map(S::to_f64);
                 let dir = S::ray_dir(ray.data()).map(S::to_f64);
-                let t = h.hit.t.to_f64();
+                let t = h.t.to_f64();
                 let q: [f64; 3] = core::array::from_fn(|k| o3[k] - d[k] + t * dir[k]);
                 let n = unit(sub(&q, &c)).unwrap_or(dir.map(|x| -x));
                 let r = sp.radius.to_f64();
@@ -553,6 +561,17 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
             }
         }
     }
+}
+
+/// `ray` moved into the frame of an object moving by `motion`, at shutter time `time`: origin
+/// minus the displacement. `None` if the moved origin leaves the mode's range.
+fn moved_into_frame<S: SpawnScalar>(motion: [f32; 3], ray: &Ray<S>, time: f32) -> Option<Ray<S>> {
+    let origin = shifted(
+        S::vec_to_array(ray.origin()),
+        displacement::<S>(motion, time),
+        -1.0,
+    );
+    ray.moved(origin).ok()
 }
 
 /// `round(time·motion)` in the mode, as `f64` (exact).

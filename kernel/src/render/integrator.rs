@@ -35,21 +35,24 @@ pub(crate) fn sample_radiance<S: SpawnScalar>(
     let time = if plan.motion { stream.next_2d().0 } else { 0.0 };
     let (o, d) = r.camera.ray(x as f32 + px, y as f32 + py, lens);
     stats.camera_rays += 1;
-    let Ok(mut ray) = Ray::<S>::from_f32(o.to_array(), d.to_array(), 0.0, f32::INFINITY) else {
-        return Vec3::ZERO;
-    };
-    let mut dir = d.normalize_or_zero();
+    // The path's current ray, read in place (`&current`): copying a just-built ray out of its
+    // `Result` stalls on store forwarding, a measurable share of a primary-only render.
+    let mut current = Ray::<S>::from_f32(o.to_array(), d.to_array(), 0.0, f32::INFINITY);
+    // The ray's direction as shading sees it: the camera's is normalised only when a path
+    // needs it (a surface or light seen), so emitters and the background never pay for it.
+    let mut dir = d;
     let mut throughput = Vec3::ONE;
     let mut radiance = Vec3::ZERO;
     let mut depth = 0u32;
-    loop {
-        let Some(hit) = r.geometry.intersect(&ray, time, &mut NoStats) else {
+    // An unusable camera or reflection ray ends the path and adds nothing.
+    while let Ok(ray) = &current {
+        let Some(hit) = r.geometry.intersect(ray, time, &mut NoStats) else {
             radiance += throughput * Vec3::from_array(r.background);
             break;
         };
         let object = match hit.surface {
             Surface::Light { light } => {
-                radiance += throughput * light_seen(r, light, dir);
+                radiance += throughput * light_seen(r, light, unit_at(dir, depth));
                 break;
             }
             Surface::Object { object, .. } => object,
@@ -67,12 +70,13 @@ pub(crate) fn sample_radiance<S: SpawnScalar>(
             }
             Some(m) => m,
         };
-        let Some(sp) = r.geometry.surface_point(&ray, &hit, time) else {
+        let Some(sp) = r.geometry.surface_point(ray, &hit, time) else {
             break;
         };
+        let dir_unit = unit_at(dir, depth);
         let n = Vec3::from_array(sp.normal);
         // Two-sided surfaces: shade with the normal facing the incoming ray.
-        let nf = if n.dot(dir) > 0.0 { -n } else { n };
+        let nf = if n.dot(dir_unit) > 0.0 { -n } else { n };
         match material {
             Material::Emissive { .. } => break, // ended the path above
             Material::Diffuse { albedo } => {
@@ -85,7 +89,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar>(
                     break;
                 }
                 throughput *= Vec3::from_array(*reflectance);
-                dir = reflect(dir, nf);
+                dir = reflect(dir_unit, nf);
             }
             Material::Glossy {
                 reflectance,
@@ -95,7 +99,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar>(
                     break;
                 }
                 let (a, b) = stream.next_2d();
-                let lobe = to_world(phong_lobe(a, b, *exponent), reflect(dir, nf));
+                let lobe = to_world(phong_lobe(a, b, *exponent), reflect(dir_unit, nf));
                 if lobe.dot(nf) <= 0.0 {
                     break;
                 }
@@ -109,13 +113,20 @@ pub(crate) fn sample_radiance<S: SpawnScalar>(
         }
         let origin = sp.spawn_origin(dir.to_array());
         stats.reflection_rays += 1;
-        let Ok(next) = Ray::<S>::new(S::array_to_vec(origin), dir_in_mode::<S>(dir.to_array()))
-        else {
-            break;
-        };
-        ray = next;
+        current = Ray::<S>::new(S::array_to_vec(origin), dir_in_mode::<S>(dir.to_array()));
     }
     radiance
+}
+
+/// The path's direction at bounce `depth` as a unit vector: the camera's (depth 0) is
+/// normalised here; reflected ones already are what shading uses.
+#[inline]
+fn unit_at(dir: Vec3, depth: u32) -> Vec3 {
+    if depth == 0 {
+        dir.normalize_or_zero()
+    } else {
+        dir
+    }
 }
 
 fn reflect(d: Vec3, n: Vec3) -> Vec3 {

@@ -198,6 +198,7 @@ fn check_raw(x: i32) -> Result<(), PointError> {
 }
 
 impl FixedRay {
+    #[inline]
     fn new(origin: [I16F16; 3], unit: [f64; 3]) -> Result<Self, RayError> {
         for x in origin {
             check_raw(x.0).map_err(RayError::Origin)?;
@@ -320,6 +321,7 @@ impl Scalar for I16F16 {
         let unit = super::float::unit_dir_f64([dir[0].0 as f64, dir[1].0 as f64, dir[2].0 as f64])?;
         FixedRay::new(origin, unit)
     }
+    #[inline]
     fn ray_data_from_f32(origin: [f32; 3], dir: [f32; 3]) -> Result<FixedRay, RayError> {
         let mut o = [I16F16::ZERO; 3];
         for i in 0..3 {

@@ -287,6 +287,11 @@ pub fn query<S: TestScalar, A: Accel<S>>(
     if occluded != hit.is_some() {
         return Err(format!("occluded() = {occluded} but intersect() = {hit:?}"));
     }
+    // `nearest` is `intersect` without barycentrics: the same t bits and primitive.
+    let nearest = accel.nearest(ray).map(|n| (n.t.bits(), n.prim));
+    if nearest != hit.map(|h| (h.t.bits(), h.prim)) {
+        return Err(format!("nearest() = {nearest:?} but intersect() = {hit:?}"));
+    }
     Ok(hit)
 }
 

@@ -1,15 +1,15 @@
 //! Stack-based traversal, near child first. One routine serves closest hit and any hit.
 
 use super::{Bvh, Node, MAX_DEPTH};
-use crate::accel::{Accel, Counters};
-use crate::geom::{closer, Hit, Primitive, Ray};
+use crate::accel::{Accel, Counters, Nearest};
+use crate::geom::{closer, Primitive, Ray};
 use crate::scalar::Scalar;
 
 impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
     /// Walks the tree. With `ANY`, returns at the first hit in range; otherwise finds the
     /// closest under [`closer`]. Returns (t, prim id, index into `prims`) of the hit;
     /// `prim id == u32::MAX` for none.
-    #[inline(always)]
+    #[inline(never)]
     fn traverse<const ANY: bool, C: Counters>(
         &self,
         ray: &Ray<S>,
@@ -28,9 +28,9 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
             return (best_t, best_prim, best_at);
         }
         // Each level below the root pushes at most one entry, and leaves are at most
-        // MAX_DEPTH deep, so the stack cannot overflow.
-        let mut stack = [(0u32, S::ZERO); MAX_DEPTH];
-        let mut sp = 0usize;
+        // MAX_DEPTH deep, so the stack cannot overflow. `heapless::Vec` leaves its storage
+        // uninitialised: a zeroed array cost a 512-byte memset per ray.
+        let mut stack: heapless::Vec<(u32, S), MAX_DEPTH> = heapless::Vec::new();
         let mut node: &Node<S> = root;
         'walk: loop {
             if node.count > 0 {
@@ -67,10 +67,8 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                         (Some(ta), Some(tb)) => {
                             let (near, far, t_far) =
                                 if tb < ta { (b, l, ta) } else { (a, l + 1, tb) };
-                            if let Some(slot) = stack.get_mut(sp) {
-                                *slot = (far as u32, t_far);
-                                sp += 1;
-                            }
+                            // Cannot fail (see above); a failed push would only skip `far`.
+                            let _ = stack.push((far as u32, t_far));
                             node = near;
                             continue 'walk;
                         }
@@ -88,13 +86,9 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
             }
             // Pop the next node still in reach of the current best.
             loop {
-                if sp == 0 {
+                let Some((index, t_near)) = stack.pop() else {
                     break 'walk;
-                }
-                sp -= 1;
-                // `% MAX_DEPTH` is a no-op (pushes stop at MAX_DEPTH entries) that compiles to a
-                // mask and keeps the bounds-check panic out of the loop.
-                let (index, t_near) = stack[sp % MAX_DEPTH];
+                };
                 if t_near <= S::widen(best_t) {
                     if let Some(n) = self.nodes.get(index as usize) {
                         node = n;
@@ -109,14 +103,15 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
 
 impl<S: Scalar, P: Primitive<S>> Accel<S> for Bvh<'_, S, P> {
     #[inline]
-    fn intersect_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Hit<S>> {
-        let (t, prim, at) = self.traverse::<false, C>(ray, stats);
-        if prim == u32::MAX {
-            return None;
-        }
-        let p = self.prims.get(at)?;
-        let (u, v) = p.hit_uv(ray.data());
-        Some(Hit { t, prim, u, v })
+    fn nearest_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Nearest<S>> {
+        let (t, prim, slot) = self.traverse::<false, C>(ray, stats);
+        (prim != u32::MAX).then_some(Nearest { t, prim, slot })
+    }
+
+    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
+        self.prims
+            .get(found.slot)
+            .map_or((S::ZERO, S::ZERO), |p| p.hit_uv(ray.data()))
     }
 
     #[inline]

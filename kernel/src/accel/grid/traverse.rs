@@ -1,8 +1,8 @@
 //! The rounding-proof 3D-DDA: a sweep over per-axis slab intervals (see the module docs).
 
 use super::{Grid, Layout, MAILBOX};
-use crate::accel::{Accel, Counters};
-use crate::geom::{closer, Hit, Primitive, Ray};
+use crate::accel::{Accel, Counters, Nearest};
+use crate::geom::{closer, Primitive, Ray};
 use crate::scalar::Scalar;
 
 /// One axis of the walk. Cells are numbered `m = 0..n` in the order the ray meets them
@@ -261,13 +261,19 @@ impl<S: Scalar, P: Primitive<S>> Grid<'_, S, P> {
 
 impl<S: Scalar, P: Primitive<S>> Accel<S> for Grid<'_, S, P> {
     #[inline]
-    fn intersect_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Hit<S>> {
+    fn nearest_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Nearest<S>> {
         let (t, prim) = self.traverse::<false, C>(ray, stats);
-        if prim == u32::MAX {
-            return None;
-        }
-        let (u, v) = self.prims.get(prim as usize)?.hit_uv(ray.data());
-        Some(Hit { t, prim, u, v })
+        (prim != u32::MAX).then_some(Nearest {
+            t,
+            prim,
+            slot: prim as usize,
+        })
+    }
+
+    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
+        self.prims
+            .get(found.slot)
+            .map_or((S::ZERO, S::ZERO), |p| p.hit_uv(ray.data()))
     }
 
     #[inline]

@@ -2,8 +2,8 @@
 
 use super::{KdTree, MAX_DEPTH};
 use crate::accel::grid::MAILBOX;
-use crate::accel::{Accel, Counters};
-use crate::geom::{closer, Hit, Primitive, Ray};
+use crate::accel::{Accel, Counters, Nearest};
+use crate::geom::{closer, Primitive, Ray};
 use crate::scalar::Scalar;
 
 /// A node still to visit: its index, box and slab entry distance.
@@ -151,13 +151,19 @@ impl<S: Scalar, P: Primitive<S>> KdTree<'_, S, P> {
 
 impl<S: Scalar, P: Primitive<S>> Accel<S> for KdTree<'_, S, P> {
     #[inline]
-    fn intersect_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Hit<S>> {
+    fn nearest_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Nearest<S>> {
         let (t, prim) = self.traverse::<false, C>(ray, stats);
-        if prim == u32::MAX {
-            return None;
-        }
-        let (u, v) = self.prims.get(prim as usize)?.hit_uv(ray.data());
-        Some(Hit { t, prim, u, v })
+        (prim != u32::MAX).then_some(Nearest {
+            t,
+            prim,
+            slot: prim as usize,
+        })
+    }
+
+    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
+        self.prims
+            .get(found.slot)
+            .map_or((S::ZERO, S::ZERO), |p| p.hit_uv(ray.data()))
     }
 
     #[inline]
