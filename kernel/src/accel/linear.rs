@@ -41,9 +41,7 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for Linear<'_, S, P> {
     }
 
     fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
-        self.prims
-            .get(found.slot)
-            .map_or((S::ZERO, S::ZERO), |p| p.hit_uv(ray.data()))
+        found.barycentrics_in(self.prims, ray)
     }
 
     fn occluded_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> bool {

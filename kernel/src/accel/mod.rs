@@ -11,7 +11,7 @@ mod linear;
 
 pub use linear::Linear;
 
-use crate::geom::{Hit, Ray};
+use crate::geom::{Hit, Primitive, Ray};
 use crate::scalar::Scalar;
 
 /// Traversal counters, for benchmarks. The [`NoStats`] implementation compiles to nothing.
@@ -66,6 +66,23 @@ pub struct Nearest<S: Scalar> {
     pub prim: u32,
     /// Index of that primitive in the accelerator's primitive storage.
     pub(crate) slot: usize,
+}
+
+impl<S: Scalar> Nearest<S> {
+    /// From a traversal's result, where `prim == u32::MAX` means no hit.
+    #[inline]
+    pub(crate) fn found(t: S, prim: u32, slot: usize) -> Option<Self> {
+        (prim != u32::MAX).then_some(Self { t, prim, slot })
+    }
+
+    /// Barycentrics of this hit on `prims[slot]` (zero if the slot is out of range, which a
+    /// hit of the accelerator owning `prims` never is).
+    #[inline]
+    pub(crate) fn barycentrics_in<P: Primitive<S>>(&self, prims: &[P], ray: &Ray<S>) -> (S, S) {
+        prims
+            .get(self.slot)
+            .map_or((S::ZERO, S::ZERO), |p| p.hit_uv(ray.data()))
+    }
 }
 
 /// The query API every accelerator offers.

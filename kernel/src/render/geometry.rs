@@ -442,18 +442,20 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
     ) -> Option<SceneHit<S>> {
         let mut best: Option<SceneHit<S>> = None;
         let mut best_t = ray.t_max();
+        let mut shortened: Ray<S>;
         for (i, o) in self.objects().enumerate() {
-            // Until something is hit the ray's own interval applies: no copy of the ray (a
-            // fresh ray copied whole stalls on store forwarding, measurably per camera ray).
-            let h = if best.is_none() {
-                Self::query_object(o, ray, time, c, ShapeIndex::nearest)
+            // The ray itself until something is hit (copying a just-built ray stalls on store
+            // forwarding, measurably per camera ray), then a copy ending at the closest hit.
+            let r = if best.is_none() {
+                ray
             } else {
                 let Ok(r) = ray.with_interval(ray.t_min(), best_t) else {
                     continue;
                 };
-                Self::query_object(o, &r, time, c, ShapeIndex::nearest)
+                shortened = r;
+                &shortened
             };
-            let h = h.flatten();
+            let h = Self::query_object(o, r, time, c, ShapeIndex::nearest).flatten();
             if let Some(h) = h {
                 let id = o.base.saturating_add(h.prim);
                 if best.is_none_or(|b| closer(h.t, id, best_t, b.prim)) {

@@ -9,6 +9,9 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
     /// Walks the tree. With `ANY`, returns at the first hit in range; otherwise finds the
     /// closest under [`closer`]. Returns (t, prim id, index into `prims`) of the hit;
     /// `prim id == u32::MAX` for none.
+    ///
+    /// Not inlined: every caller (renderer, host, benchmarks) runs the same machine code, so
+    /// their timings differ only by what they do around the walk.
     #[inline(never)]
     fn traverse<const ANY: bool, C: Counters>(
         &self,
@@ -105,13 +108,11 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for Bvh<'_, S, P> {
     #[inline]
     fn nearest_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Nearest<S>> {
         let (t, prim, slot) = self.traverse::<false, C>(ray, stats);
-        (prim != u32::MAX).then_some(Nearest { t, prim, slot })
+        Nearest::found(t, prim, slot)
     }
 
     fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
-        self.prims
-            .get(found.slot)
-            .map_or((S::ZERO, S::ZERO), |p| p.hit_uv(ray.data()))
+        found.barycentrics_in(self.prims, ray)
     }
 
     #[inline]

@@ -153,17 +153,11 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for KdTree<'_, S, P> {
     #[inline]
     fn nearest_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Nearest<S>> {
         let (t, prim) = self.traverse::<false, C>(ray, stats);
-        (prim != u32::MAX).then_some(Nearest {
-            t,
-            prim,
-            slot: prim as usize,
-        })
+        Nearest::found(t, prim, prim as usize)
     }
 
     fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
-        self.prims
-            .get(found.slot)
-            .map_or((S::ZERO, S::ZERO), |p| p.hit_uv(ray.data()))
+        found.barycentrics_in(self.prims, ray)
     }
 
     #[inline]
