@@ -30,7 +30,8 @@
 //! assert_eq!((hit.t, hit.prim), (5.0, 0));
 //! ```
 #![no_std]
-#![forbid(unsafe_code)]
+// The one exception: SSE intrinsics in `scalar/lanes.rs` (see there).
+#![deny(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod accel;

@@ -7,6 +7,7 @@
 
 mod fixed;
 mod float;
+mod lanes;
 
 pub use fixed::{FixedRay, Vec3x, FIXED_COORD_LIMIT, I16F16};
 pub use float::{FloatRay, F32_COORD_LIMIT};
@@ -102,6 +103,21 @@ pub trait Scalar:
         t_min: Self,
         t_max: Self,
     ) -> Option<Self>;
+    /// [`Scalar::slab`] of two boxes `(lo, hi)` at once (a BVH node's children), with the same
+    /// results: bit for bit the same entry distances.
+    #[inline(always)]
+    fn slab_pair(
+        ray: &Self::RayData,
+        a: (&[Self; 3], &[Self; 3]),
+        b: (&[Self; 3], &[Self; 3]),
+        t_min: Self,
+        t_max: Self,
+    ) -> [Option<Self>; 2] {
+        [
+            Self::slab(ray, a.0, a.1, t_min, t_max),
+            Self::slab(ray, b.0, b.1, t_min, t_max),
+        ]
+    }
     /// `t >= 0` widened by the slab test's margin: the test accepts boxes entered up to
     /// `widen(t)`.
     #[must_use]

@@ -64,8 +64,7 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                 if let Some([a, b]) = self.nodes.get(l..l + 2) {
                     stats.node();
                     stats.node();
-                    let ta = S::slab(rd, &a.lo, &a.hi, t_min, best_t);
-                    let tb = S::slab(rd, &b.lo, &b.hi, t_min, best_t);
+                    let [ta, tb] = S::slab_pair(rd, (&a.lo, &a.hi), (&b.lo, &b.hi), t_min, best_t);
                     match (ta, tb) {
                         (Some(ta), Some(tb)) => {
                             let (near, far, t_far) =

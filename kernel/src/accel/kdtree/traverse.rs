@@ -77,8 +77,7 @@ impl<S: Scalar, P: Primitive<S>> KdTree<'_, S, P> {
                 above_lo[a] = node.split;
                 stats.node();
                 stats.node();
-                let tb = S::slab(rd, &lo, &below_hi, t_min, best_t);
-                let ta = S::slab(rd, &above_lo, &hi, t_min, best_t);
+                let [tb, ta] = S::slab_pair(rd, (&lo, &below_hi), (&above_lo, &hi), t_min, best_t);
                 match (tb, ta) {
                     (Some(tb), Some(ta)) => {
                         let (far, near_below) = if ta < tb {

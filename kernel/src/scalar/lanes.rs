@@ -1,0 +1,246 @@
+//! Four `f32` lanes with exactly the per-lane IEEE semantics of scalar code.
+//!
+//! With SSE2 (every `x86_64`) the lanes live in one SSE register; elsewhere in a `[f32; 4]`. Every operation
+//! is the same IEEE operation in each lane on both (SSE arithmetic rounds as scalar `f32`
+//! does, and `min`/`max` are defined as the SSE instructions are, which is how the scalar code
+//! writes them), so code written against [`F4`] gives the same bits on every target. Only
+//! operations the two backends agree on bit for bit belong here.
+
+#[cfg(target_feature = "sse2")]
+#[allow(unsafe_code)]
+mod sse {
+    // SAFETY (every `unsafe` block below): these intrinsics have no precondition beyond the
+    // CPU supporting SSE/SSE2, which `cfg(target_feature = "sse2")` guarantees at compile
+    // time (it is part of the x86_64 baseline). None of them touches memory.
+    use arch::{
+        __m128, _mm_cmple_ps, _mm_cvtss_f32, _mm_max_ps, _mm_min_ps, _mm_movehl_ps,
+        _mm_movemask_ps, _mm_mul_ps, _mm_set1_ps, _mm_setr_ps, _mm_shuffle_ps, _mm_sub_ps,
+        _mm_unpackhi_ps, _mm_unpacklo_ps,
+    };
+    #[cfg(target_arch = "x86")]
+    use core::arch::x86 as arch;
+    #[cfg(target_arch = "x86_64")]
+    use core::arch::x86_64 as arch;
+
+    /// Four lanes in an SSE register.
+    #[derive(Clone, Copy)]
+    pub(crate) struct F4(__m128);
+
+    impl F4 {
+        #[inline(always)]
+        pub(crate) fn new(l: [f32; 4]) -> Self {
+            Self(unsafe { _mm_setr_ps(l[0], l[1], l[2], l[3]) })
+        }
+        #[inline(always)]
+        pub(crate) fn splat(x: f32) -> Self {
+            Self(unsafe { _mm_set1_ps(x) })
+        }
+        #[inline(always)]
+        pub(crate) fn sub(self, o: Self) -> Self {
+            Self(unsafe { _mm_sub_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        pub(crate) fn mul(self, o: Self) -> Self {
+            Self(unsafe { _mm_mul_ps(self.0, o.0) })
+        }
+        /// Per lane `if a < b { a } else { b }` (the second operand when unordered).
+        #[inline(always)]
+        pub(crate) fn min(self, o: Self) -> Self {
+            Self(unsafe { _mm_min_ps(self.0, o.0) })
+        }
+        /// Per lane `if a > b { a } else { b }` (the second operand when unordered).
+        #[inline(always)]
+        pub(crate) fn max(self, o: Self) -> Self {
+            Self(unsafe { _mm_max_ps(self.0, o.0) })
+        }
+        /// `[a0, b0, a1, b1]`.
+        #[inline(always)]
+        pub(crate) fn unpack_lo(self, o: Self) -> Self {
+            Self(unsafe { _mm_unpacklo_ps(self.0, o.0) })
+        }
+        /// `[a2, b2, a3, b3]`.
+        #[inline(always)]
+        pub(crate) fn unpack_hi(self, o: Self) -> Self {
+            Self(unsafe { _mm_unpackhi_ps(self.0, o.0) })
+        }
+        /// `[a2, a3, a2, a3]`.
+        #[inline(always)]
+        pub(crate) fn high_half(self) -> Self {
+            Self(unsafe { _mm_movehl_ps(self.0, self.0) })
+        }
+        /// Bit `i` set if lane `i` of `self <= o` (false when unordered).
+        #[inline(always)]
+        pub(crate) fn le_mask(self, o: Self) -> u32 {
+            unsafe { _mm_movemask_ps(_mm_cmple_ps(self.0, o.0)) as u32 }
+        }
+        #[inline(always)]
+        pub(crate) fn lane0(self) -> f32 {
+            unsafe { _mm_cvtss_f32(self.0) }
+        }
+        #[inline(always)]
+        pub(crate) fn lane1(self) -> f32 {
+            unsafe { _mm_cvtss_f32(_mm_shuffle_ps::<0b01>(self.0, self.0)) }
+        }
+    }
+}
+
+#[cfg(any(test, not(target_feature = "sse2")))]
+mod portable {
+    /// Four lanes in an array.
+    #[derive(Clone, Copy)]
+    pub(crate) struct F4([f32; 4]);
+
+    impl F4 {
+        #[inline(always)]
+        pub(crate) fn new(l: [f32; 4]) -> Self {
+            Self(l)
+        }
+        #[inline(always)]
+        pub(crate) fn splat(x: f32) -> Self {
+            Self([x; 4])
+        }
+        #[inline(always)]
+        fn zip(self, o: Self, f: impl Fn(f32, f32) -> f32) -> Self {
+            Self(core::array::from_fn(|i| f(self.0[i], o.0[i])))
+        }
+        #[inline(always)]
+        pub(crate) fn sub(self, o: Self) -> Self {
+            self.zip(o, |a, b| a - b)
+        }
+        #[inline(always)]
+        pub(crate) fn mul(self, o: Self) -> Self {
+            self.zip(o, |a, b| a * b)
+        }
+        #[inline(always)]
+        pub(crate) fn min(self, o: Self) -> Self {
+            self.zip(o, |a, b| if a < b { a } else { b })
+        }
+        #[inline(always)]
+        pub(crate) fn max(self, o: Self) -> Self {
+            self.zip(o, |a, b| if a > b { a } else { b })
+        }
+        #[inline(always)]
+        pub(crate) fn unpack_lo(self, o: Self) -> Self {
+            let (a, b) = (self.0, o.0);
+            Self([a[0], b[0], a[1], b[1]])
+        }
+        #[inline(always)]
+        pub(crate) fn unpack_hi(self, o: Self) -> Self {
+            let (a, b) = (self.0, o.0);
+            Self([a[2], b[2], a[3], b[3]])
+        }
+        #[inline(always)]
+        pub(crate) fn high_half(self) -> Self {
+            let a = self.0;
+            Self([a[2], a[3], a[2], a[3]])
+        }
+        #[inline(always)]
+        pub(crate) fn le_mask(self, o: Self) -> u32 {
+            (0..4).fold(0, |m, i| m | (u32::from(self.0[i] <= o.0[i]) << i))
+        }
+        #[inline(always)]
+        pub(crate) fn lane0(self) -> f32 {
+            self.0[0]
+        }
+        #[inline(always)]
+        pub(crate) fn lane1(self) -> f32 {
+            self.0[1]
+        }
+    }
+}
+
+#[cfg(not(target_feature = "sse2"))]
+pub(crate) use portable::F4;
+#[cfg(target_feature = "sse2")]
+pub(crate) use sse::F4;
+
+#[cfg(test)]
+mod tests {
+    use super::F4;
+
+    /// Every operation of the SSE backend against the portable one, bit for bit, on lanes
+    /// drawn from a list of awkward values (NaN, infinities, signed zeros, subnormals).
+    #[cfg(target_feature = "sse2")]
+    #[test]
+    fn sse_and_portable_backends_agree_bit_for_bit() {
+        use super::{portable::F4 as P, sse::F4 as S};
+        let values = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            3.0e38,
+            -3.0e38,
+            1.0e-45,
+            -1.0e-45,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            7.25,
+            -2.5,
+        ];
+        let n = values.len();
+        let bits = |l0: f32, l1: f32| [l0.to_bits(), l1.to_bits()];
+        let lanes_at = |k: usize| -> [f32; 4] {
+            core::array::from_fn(|i| values[(k * 7 + i * 3 + k / n) % n])
+        };
+        for k in 0..n * n {
+            let (a, b) = (lanes_at(k), lanes_at(k * 5 + 1));
+            let (pa, pb, sa, sb) = (P::new(a), P::new(b), S::new(a), S::new(b));
+            let same = |p: P, s: S, what: &str| {
+                assert_eq!(
+                    bits(p.lane0(), p.lane1()),
+                    bits(s.lane0(), s.lane1()),
+                    "{what} {a:?} {b:?}"
+                );
+            };
+            same(pa.sub(pb), sa.sub(sb), "sub");
+            same(pa.mul(pb), sa.mul(sb), "mul");
+            same(pa.min(pb), sa.min(sb), "min");
+            same(pa.max(pb), sa.max(sb), "max");
+            same(pa.unpack_lo(pb), sa.unpack_lo(sb), "unpack_lo");
+            same(pa.unpack_hi(pb), sa.unpack_hi(sb), "unpack_hi");
+            same(pa.high_half(), sa.high_half(), "high_half");
+            same(P::splat(a[0]), S::splat(a[0]), "splat");
+            assert_eq!(pa.le_mask(pb), sa.le_mask(sb), "le_mask {a:?} {b:?}");
+        }
+    }
+
+    fn lanes(v: F4) -> [u32; 2] {
+        [v.lane0().to_bits(), v.lane1().to_bits()]
+    }
+
+    #[test]
+    fn min_and_max_return_the_second_operand_unless_the_first_wins() {
+        let nan = f32::NAN;
+        let cases = [
+            (1.0, 2.0),
+            (2.0, 1.0),
+            (nan, 1.0),
+            (1.0, nan),
+            (0.0, -0.0),
+            (-0.0, 0.0),
+        ];
+        for (a, b) in cases {
+            let (x, y) = (F4::new([a, b, 0.0, 0.0]), F4::new([b, a, 0.0, 0.0]));
+            let want_min = [if a < b { a } else { b }, if b < a { b } else { a }];
+            let want_max = [if a > b { a } else { b }, if b > a { b } else { a }];
+            assert_eq!(lanes(x.min(y)), want_min.map(f32::to_bits), "min {a} {b}");
+            assert_eq!(lanes(x.max(y)), want_max.map(f32::to_bits), "max {a} {b}");
+        }
+    }
+
+    #[test]
+    fn shuffles_and_masks_move_the_documented_lanes() {
+        let a = F4::new([1.0, 2.0, 3.0, 4.0]);
+        let b = F4::new([5.0, 6.0, 7.0, 8.0]);
+        assert_eq!(lanes(a.unpack_lo(b)), [1.0f32, 5.0].map(f32::to_bits));
+        assert_eq!(lanes(a.unpack_hi(b)), [3.0f32, 7.0].map(f32::to_bits));
+        assert_eq!(lanes(a.high_half()), [3.0f32, 4.0].map(f32::to_bits));
+        let c = F4::new([1.0, 9.0, f32::NAN, 4.0]);
+        assert_eq!(a.le_mask(c), 0b1011);
+        let sum = b.sub(F4::splat(1.0)).mul(F4::splat(2.0));
+        assert_eq!(lanes(sum), [8.0f32, 10.0].map(f32::to_bits));
+    }
+}
