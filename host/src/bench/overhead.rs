@@ -9,7 +9,8 @@
 //! - [`Workload::Shadow`]: a diffuse material and one point light against a caster that also
 //!   casts the shadow ray (the kernel's spawn rule) and shades Lambert.
 //!
-//! `host bench` reports medians of interleaved runs; `cargo bench -p raykernel-host --bench
+//! `host bench` reports medians of interleaved runs (the overhead as the median of each run's
+//! ratio); `cargo bench -p raykernel-host --bench
 //! render_overhead` measures the same fixtures with criterion.
 
 use crate::mesh::unit_icosphere;
@@ -115,6 +116,10 @@ fn write_rgb(out: &mut [u8], x: u32, y: u32, c: [f32; 3]) {
 }
 
 /// The bare primary-ray caster: camera ray, closest hit, the emitter's colour or the background.
+///
+/// Not inlined, like the renderer's tile loop: each is then one copy per mode in every binary,
+/// and the comparison does not depend on how a caller's closure happened to be compiled.
+#[inline(never)]
 fn bare_primary<S: SpawnScalar>(bvh: &Bvh<'_, S, Triangle<S>>, out: &mut [u8]) {
     let frame = camera_frame();
     for y in 0..SIZE {
@@ -129,7 +134,8 @@ fn bare_primary<S: SpawnScalar>(bvh: &Bvh<'_, S, Triangle<S>>, out: &mut [u8]) {
 }
 
 /// The bare shadow caster: camera ray, closest hit, one shadow ray by the kernel's spawn rule,
-/// Lambert shading of a point light.
+/// Lambert shading of a point light. Not inlined, as [`bare_primary`].
+#[inline(never)]
 fn bare_shadow<S: SpawnScalar>(
     bvh: &Bvh<'_, S, Triangle<S>>,
     tris: &[Triangle<S>],
@@ -244,7 +250,9 @@ pub struct OverheadRow {
     pub bare_ms: f64,
     /// Median wall time of the renderer, ms.
     pub renderer_ms: f64,
-    /// `renderer / bare − 1`, percent.
+    /// Median over the runs of `renderer / bare − 1`, each run's pair timed back to back,
+    /// percent. (A ratio per pair cancels the machine's slow and fast spells, which a ratio of
+    /// the two medians does not.)
     pub overhead_pct: f64,
     /// Bytes of the two images that differ (0: the same picture).
     pub differing_bytes: usize,
@@ -279,16 +287,17 @@ fn measure<S: SpawnScalar>(workload: Workload, runs: usize) -> OverheadRow {
             renderer_ms.push(time(render, &mut b));
         }
     });
-    let (bare, renderer) = (
-        crate::trace::median(&bare_ms),
-        crate::trace::median(&renderer_ms),
-    );
+    let ratios: Vec<f64> = renderer_ms
+        .iter()
+        .zip(&bare_ms)
+        .map(|(r, b)| r / b)
+        .collect();
     OverheadRow {
         workload: workload.name().into(),
         mode: S::NAME.into(),
-        bare_ms: bare,
-        renderer_ms: renderer,
-        overhead_pct: (renderer / bare - 1.0) * 100.0,
+        bare_ms: crate::trace::median(&bare_ms),
+        renderer_ms: crate::trace::median(&renderer_ms),
+        overhead_pct: (crate::trace::median(&ratios) - 1.0) * 100.0,
         differing_bytes: a.iter().zip(&b).filter(|(x, y)| x != y).count(),
     }
 }

@@ -97,6 +97,8 @@ pub(super) fn unit_dir_f64(d: [f64; 3]) -> Result<[f64; 3], RayError> {
 }
 
 impl FloatRay {
+    /// Inlined into the ray constructors: see `ray_data` in the `Scalar` impl below.
+    #[inline(always)]
     fn new(origin: [f32; 3], dir: [f32; 3]) -> Result<Self, RayError> {
         for &x in &origin {
             check_coord(x).map_err(RayError::Origin)?;
@@ -139,20 +141,26 @@ impl FloatRay {
     }
 
     /// The origins the slab test sees (see the fields' docs), z repeated in lane 3.
+    ///
+    /// Each lane is `shift(x, delta, up)` with `delta = o_max · MARGIN`, written branch-free as
+    /// `x ± max(delta, TINY)` (the smallest subnormal): the same value, because `|x| <= o_max`
+    /// makes a non-zero `delta` at least 16 ulps of `x`, so `x ± delta` never rounds back to
+    /// `x`; and a zero `delta` means `|x|` is zero or subnormal, whose next value is `x ± TINY`
+    /// (a test checks this against `shift`; only the sign of a zero result can differ, which
+    /// no comparison sees). Plain arithmetic lets the two arrays be built and
+    /// stored as whole vectors: read back by the slab test, lane-wise stores stalled on store
+    /// forwarding.
+    #[inline(always)]
     fn shifted_origins(origin: [f32; 3]) -> ([f32; 4], [f32; 4]) {
+        const TINY: f32 = f32::from_bits(1);
         let o_max = abs(origin[0]).max_of(abs(origin[1])).max_of(abs(origin[2]));
         let delta = o_max * MARGIN;
-        let mut o_lo = [0.0; 4];
-        let mut o_hi = [0.0; 4];
-        for i in 0..4 {
-            let i3 = i.min(2);
-            // Seen from shifted origins the box grows by `delta` on each side, whichever plane
-            // is near: `lo - (o + delta)` and `hi - (o - delta)`. For a zero component an origin
-            // inside the slab then sees `-inf` and `+inf`, never `0 * inf`.
-            o_lo[i] = shift(origin[i3], delta, true);
-            o_hi[i] = shift(origin[i3], delta, false);
-        }
-        (o_lo, o_hi)
+        let d = if delta > TINY { delta } else { TINY };
+        let [x, y, z] = origin;
+        // Seen from shifted origins the box grows by `delta` on each side, whichever plane is
+        // near: `lo - (o + delta)` and `hi - (o - delta)`. For a zero component an origin inside
+        // the slab then sees `-inf` and `+inf`, never `0 * inf`.
+        ([x + d, y + d, z + d, z + d], [x - d, y - d, z - d, z - d])
     }
 
     fn moved(&self, origin: [f32; 3]) -> Result<Self, RayError> {
@@ -305,9 +313,15 @@ impl Scalar for f32 {
         }
     }
 
+    // The ray constructors are inlined down to `FloatRay::new`, so a ray is built where it is
+    // stored. Returned through memory and then moved into the `Ray`, it was re-read with
+    // 16-byte loads over narrower stores, which stall on store forwarding: measured at about a
+    // tenth of a primary-only render's time.
+    #[inline(always)]
     fn ray_data(origin: [f32; 3], dir: [f32; 3]) -> Result<FloatRay, RayError> {
         FloatRay::new(origin, dir)
     }
+    #[inline(always)]
     fn ray_data_from_f32(origin: [f32; 3], dir: [f32; 3]) -> Result<FloatRay, RayError> {
         FloatRay::new(origin, dir)
     }
@@ -512,6 +526,48 @@ mod tests {
         assert_eq!(step(1.0, false), f32::from_bits(1.0f32.to_bits() - 1));
         assert_eq!(step(-1.0, true), f32::from_bits((-1.0f32).to_bits() - 1));
         assert!(step(0.0, true) > 0.0 && step(0.0, false) < 0.0);
+    }
+
+    #[test]
+    fn shifted_origins_move_each_lane_as_shift_does() {
+        let tiny = f32::from_bits(1);
+        let values = [
+            0.0,
+            -0.0,
+            tiny,
+            -tiny,
+            3.0 * tiny,
+            1e-40,
+            -1e-39,
+            1.17e-38,
+            1e-30,
+            1e-20,
+            0.5,
+            1.0,
+            -1.0,
+            3.0,
+            1234.5,
+            -1e6,
+            7.3e11,
+            F32_COORD_LIMIT,
+            -F32_COORD_LIMIT,
+        ];
+        for &a in &values {
+            for &b in &values {
+                for &c in &values {
+                    let origin = [a, b, c];
+                    let o_max = abs(a).max_of(abs(b)).max_of(abs(c));
+                    let delta = o_max * MARGIN;
+                    let (lo, hi) = FloatRay::shifted_origins(origin);
+                    for i in 0..4 {
+                        let x = origin[i.min(2)];
+                        // Equal as values (a zero's sign may differ), strictly beyond `x`.
+                        assert!(lo[i] == shift(x, delta, true) && lo[i] > x, "{origin:?}");
+                        assert!(hi[i] == shift(x, delta, false) && hi[i] < x, "{origin:?}");
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -17,7 +17,11 @@ struct Entry<S> {
 
 impl<S: Scalar, P: Primitive<S>> KdTree<'_, S, P> {
     /// Returns (t, prim) of the hit; `prim == u32::MAX` for none.
-    #[inline(always)]
+    ///
+    /// Not inlined, as the BVH's and the grid's walks: every caller runs the same machine code,
+    /// and a caller that dispatches over accelerators (the renderer) does not carry this walk's
+    /// stack in its own frame on every ray.
+    #[inline(never)]
     fn traverse<const ANY: bool, C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> (S, u32) {
         let rd = ray.data();
         let t_min = ray.t_min();
