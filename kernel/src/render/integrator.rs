@@ -13,7 +13,11 @@ use core::f32::consts::FRAC_1_PI;
 use glam::Vec3;
 
 /// Radiance of one pixel sample.
-#[inline]
+///
+/// Always inlined into the pixel loop, as [`super::Renderer::pixel`] is: left to the optimiser,
+/// a large binary (the host's, with link-time optimisation) kept both out of line, and the
+/// calls and the values passed through memory cost a primary-only render about a tenth.
+#[inline(always)]
 pub(crate) fn sample_radiance<S: SpawnScalar>(
     r: &Renderer<'_, S>,
     x: u32,
