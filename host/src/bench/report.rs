@@ -774,7 +774,8 @@ fn overhead_section(s: &mut String, r: &BenchResults) {
         s,
         "## Render plan overhead: the renderer against hand-written casters\n\n\
          Same BVH, single thread, 256×256, a 20,480-triangle icosphere on a floor; medians of \
-         interleaved runs. `primary`: a scene that uses no effect (1 spp, pinhole, static, no \
+         interleaved runs (the overhead: the median of each run's renderer ÷ bare ratio). \
+         `primary`: a scene that uses no effect (1 spp, pinhole, static, no \
          lights, emissive objects) against a bare primary-ray caster (camera ray, closest hit, \
          colour, sRGB); `shadow`: a diffuse scene with one point light against a caster that \
          also casts the shadow ray and shades Lambert (`host/src/bench/overhead.rs`). \
