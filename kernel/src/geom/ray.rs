@@ -21,7 +21,7 @@ impl<S: Scalar> Ray<S> {
     /// and [`RayError::NonFiniteDirection`] for an unusable direction.
     // Always inlined, like the per-mode constructors under it: a ray returned through memory
     // and then moved stalls its first reader on store forwarding (see `ray_data` for `f32`).
-    #[inline(always)]
+    #[cfg_attr(not(target_os = "none"), inline(always))]
     pub fn new(origin: S::Vec3, dir: S::Vec3) -> Result<Self, RayError> {
         let data = S::ray_data(S::vec_to_array(origin), S::vec_to_array(dir))?;
         Ok(Self {
@@ -36,7 +36,7 @@ impl<S: Scalar> Ray<S> {
     ///
     /// # Errors
     /// As [`Ray::new`], plus [`RayError::InvalidInterval`].
-    #[inline(always)]
+    #[cfg_attr(not(target_os = "none"), inline(always))]
     pub fn from_f32(
         origin: [f32; 3],
         dir: [f32; 3],

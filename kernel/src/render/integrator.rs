@@ -14,10 +14,12 @@ use glam::Vec3;
 
 /// Radiance of one pixel sample.
 ///
-/// Always inlined into the pixel loop, as [`super::Renderer::pixel`] is: left to the optimiser,
-/// a large binary (the host's, with link-time optimisation) kept both out of line, and the
-/// calls and the values passed through memory cost a primary-only render about a tenth.
-#[inline(always)]
+/// Always inlined into the pixel loop on hosted targets, as [`super::Renderer::pixel`] is: left
+/// to the optimiser, a large binary (the host's, with link-time optimisation) kept both out of
+/// line, and the calls and the values passed through memory cost a primary-only render about a
+/// tenth. Bare-metal targets keep the optimiser's choice, for flash (see `ray_data` in
+/// `scalar/float.rs`).
+#[cfg_attr(not(target_os = "none"), inline(always))]
 pub(crate) fn sample_radiance<S: SpawnScalar>(
     r: &Renderer<'_, S>,
     x: u32,

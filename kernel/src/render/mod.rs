@@ -261,7 +261,7 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
     /// Mean linear radiance of pixel `(x, y)` over its samples (no bounds check: pixels
     /// outside the image are rendered as if the image extended there).
     #[must_use]
-    #[inline(always)] // see `integrator::sample_radiance`
+    #[cfg_attr(not(target_os = "none"), inline(always))] // see `integrator::sample_radiance`
     pub fn pixel(&self, x: u32, y: u32, stats: &mut RenderStats) -> Rgb {
         let index = y.wrapping_mul(self.settings.width).wrapping_add(x);
         let spp = self.settings.spp;

@@ -98,7 +98,7 @@ pub(super) fn unit_dir_f64(d: [f64; 3]) -> Result<[f64; 3], RayError> {
 
 impl FloatRay {
     /// Inlined into the ray constructors: see `ray_data` in the `Scalar` impl below.
-    #[inline(always)]
+    #[cfg_attr(not(target_os = "none"), inline(always))]
     fn new(origin: [f32; 3], dir: [f32; 3]) -> Result<Self, RayError> {
         for &x in &origin {
             check_coord(x).map_err(RayError::Origin)?;
@@ -150,7 +150,7 @@ impl FloatRay {
     /// no comparison sees). Plain arithmetic lets the two arrays be built and
     /// stored as whole vectors: read back by the slab test, lane-wise stores stalled on store
     /// forwarding.
-    #[inline(always)]
+    #[cfg_attr(not(target_os = "none"), inline(always))]
     fn shifted_origins(origin: [f32; 3]) -> ([f32; 4], [f32; 4]) {
         const TINY: f32 = f32::from_bits(1);
         let o_max = abs(origin[0]).max_of(abs(origin[1])).max_of(abs(origin[2]));
@@ -313,15 +313,17 @@ impl Scalar for f32 {
         }
     }
 
-    // The ray constructors are inlined down to `FloatRay::new`, so a ray is built where it is
-    // stored. Returned through memory and then moved into the `Ray`, it was re-read with
-    // 16-byte loads over narrower stores, which stall on store forwarding: measured at about a
-    // tenth of a primary-only render's time.
-    #[inline(always)]
+    // On hosted targets the ray constructors are inlined down to `FloatRay::new`, so a ray is
+    // built where it is stored. Returned through memory and then moved into the `Ray`, it was
+    // re-read with 16-byte loads over narrower stores, which stall on store forwarding on x86:
+    // measured at about a tenth of a primary-only render's time. Bare-metal targets
+    // (`target_os = "none"`) leave inlining to the optimiser: forced, it grew the renderer by
+    // 12 KB of flash (more than a Cortex-M0 test image holds), for a stall their cores lack.
+    #[cfg_attr(not(target_os = "none"), inline(always))]
     fn ray_data(origin: [f32; 3], dir: [f32; 3]) -> Result<FloatRay, RayError> {
         FloatRay::new(origin, dir)
     }
-    #[inline(always)]
+    #[cfg_attr(not(target_os = "none"), inline(always))]
     fn ray_data_from_f32(origin: [f32; 3], dir: [f32; 3]) -> Result<FloatRay, RayError> {
         FloatRay::new(origin, dir)
     }
