@@ -658,3 +658,48 @@ fn closest_hit_ties_go_to_lowest_prim_id_f32() {
 fn closest_hit_ties_go_to_lowest_prim_id_fixed() {
     tie_cases::<I16F16>();
 }
+
+/// `redirected_f32` keeps the origin's data and recomputes the direction's: the ray it gives
+/// must be `Ray::from_f32` from the same origin, bit for bit (compared through `Debug`, which
+/// prints every `f32` exactly), errors included.
+fn check_redirect<S: TestScalar>(o: [f32; 3], first: [f32; 3], d: [f32; 3]) -> Result<(), String>
+where
+    raykernel::Ray<S>: std::fmt::Debug,
+{
+    use raykernel::Ray;
+    let Ok(base) = Ray::<S>::from_f32(o, first, 0.0, f32::INFINITY) else {
+        return Ok(()); // an unusable origin or first direction: nothing to redirect
+    };
+    let want = Ray::<S>::from_f32(o, d, 0.0, f32::INFINITY);
+    let got = base.redirected_f32(d);
+    if format!("{want:?}") == format!("{got:?}") {
+        Ok(())
+    } else {
+        Err(format!("{}: from_f32 {want:?}\nredirected {got:?}", S::NAME))
+    }
+}
+
+fn component() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        4 => -1000.0f32..1000.0,
+        1 => Just(0.0f32),
+        1 => Just(-0.0f32),
+        1 => Just(1e-30f32),
+        1 => Just(f32::NAN),
+        1 => Just(f32::INFINITY),
+    ]
+}
+
+proptest! {
+    #![proptest_config(config(2000))]
+
+    #[test]
+    fn redirected_rays_equal_fresh_ones(
+        o in prop::array::uniform3(-9000.0f32..9000.0),
+        first in prop::array::uniform3(component()),
+        d in prop::array::uniform3(component()),
+    ) {
+        check_redirect::<f32>(o, first, d).map_err(TestCaseError::fail)?;
+        check_redirect::<I16F16>(o, first, d).map_err(TestCaseError::fail)?;
+    }
+}

@@ -578,6 +578,78 @@ fn plans_follow_the_scenes() {
         text.contains("anti-aliasing off") && text.contains("reflections off"),
         "{text}"
     );
+    // Its two point lights still need shadow rays; without them only camera rays are left.
+    assert!(!b.camera_rays_only() && !text.contains("camera rays only"));
+    let unlit = plan(&SceneData { lights: &[], ..bare });
+    assert!(unlit.camera_rays_only());
+    assert!(unlit.to_string().contains("camera rays only"), "{unlit}");
+}
+
+/// A plan of camera rays only takes the renderer's first-hit loop; a zero-intensity point light
+/// changes nothing in the picture of emitters, black diffuse surfaces and background but makes
+/// the plan take the general path loop. Both must give the same bits, in both modes, for
+/// every built-in scene made static, pinhole and one sample per pixel.
+fn camera_rays_only_case<S: SpawnScalar>(d: &SceneData<'_>) {
+    // Every other material emits (the rest are diffuse, black without lights).
+    let materials: Vec<Material> = (0..d.materials.len())
+        .map(|i| {
+            if i % 2 == 0 {
+                Material::Emissive {
+                    radiance: [0.2 + 0.1 * i as f32, 0.7, 0.4],
+                }
+            } else {
+                Material::Diffuse { albedo: [0.5; 3] }
+            }
+        })
+        .collect();
+    let objects: Vec<_> = d
+        .objects
+        .iter()
+        .map(|o| scenes::ObjectData {
+            motion: [0.0; 3],
+            ..*o
+        })
+        .collect();
+    let dark = [Light::Point {
+        position: [0.0, 0.5, 0.0],
+        intensity: [0.0; 3],
+    }];
+    let settings = Settings {
+        spp: 1,
+        ..d.settings
+    };
+    let mut images = Vec::new();
+    for lights in [&[][..], &dark[..]] {
+        let data = SceneData {
+            objects: &objects,
+            materials: &materials,
+            lights,
+            camera: Camera {
+                aperture_radius: 0.0,
+                ..d.camera
+            },
+            settings,
+            ..*d
+        };
+        with_scene::<S, _>(&data, |scene| {
+            let mut memory = Memory::new(scene, AccelChoice::default());
+            let r = Renderer::new(scene, settings, AccelChoice::default(), memory.lend()).unwrap();
+            assert_eq!(r.plan().camera_rays_only(), lights.is_empty(), "{}", d.name);
+            let image = render(scene, settings, AccelChoice::default()).unwrap();
+            images.push(image.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>());
+        });
+    }
+    let emitters = images[0].iter().filter(|&&b| b != 0).count();
+    assert!(emitters > 0, "{}: the picture shows something", d.name);
+    assert_eq!(images[0], images[1], "{} {}", d.name, S::NAME);
+}
+
+#[test]
+fn camera_rays_only_loop_equals_the_general_path() {
+    for d in scenes::ALL {
+        camera_rays_only_case::<f32>(&d);
+        camera_rays_only_case::<I16F16>(&d);
+    }
 }
 
 /// A valid one-object scene to corrupt field by field.

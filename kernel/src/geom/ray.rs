@@ -81,6 +81,20 @@ impl<S: Scalar> Ray<S> {
         })
     }
 
+    /// The ray from the same origin along `dir` (`f32` components), over the same interval:
+    /// the same bits as [`Ray::from_f32`] from this ray's origin would give, without checking
+    /// and preparing the origin again. A pinhole camera's rays all share its eye.
+    ///
+    /// # Errors
+    /// [`RayError::ZeroDirection`] and [`RayError::NonFiniteDirection`].
+    #[cfg_attr(not(target_os = "none"), inline(always))]
+    pub fn redirected_f32(&self, dir: [f32; 3]) -> Result<Self, RayError> {
+        Ok(Self {
+            data: S::ray_redirected_f32(&self.data, dir)?,
+            ..*self
+        })
+    }
+
     /// Origin.
     pub fn origin(&self) -> S::Vec3 {
         S::array_to_vec(S::ray_origin(&self.data))

@@ -2,6 +2,8 @@
 
 use super::sampling::concentric_disk;
 use super::scene::{finite3, Camera, Item, Problem, SceneError};
+use crate::geom::Ray;
+use crate::scalar::Scalar;
 use glam::Vec3;
 
 /// A camera's frame for one image size.
@@ -79,6 +81,13 @@ impl CameraFrame {
             inv_width: 1.0 / width as f32,
             inv_height: 1.0 / height as f32,
         })
+    }
+
+    /// The pinhole's ray along the view direction: every pinhole camera ray starts where it
+    /// does, so [`Ray::redirected_f32`] turns it into any of them. `None` if the eye is
+    /// outside the mode's range (no camera ray is usable then).
+    pub(crate) fn eye_ray<S: Scalar>(&self) -> Option<Ray<S>> {
+        Ray::<S>::from_f32(self.eye.to_array(), self.w.to_array(), 0.0, f32::INFINITY).ok()
     }
 
     /// Origin and (unnormalised) direction of the ray through image position `(x, y)` (pixels,

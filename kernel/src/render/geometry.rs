@@ -434,6 +434,7 @@ impl<'a, S: SpawnScalar> Geometry<'a, S> {
     }
 
     /// Closest hit at shutter time `time`; ties to the lowest global id.
+    #[cfg_attr(not(target_os = "none"), inline(always))]
     pub(crate) fn intersect<C: Counters>(
         &self,
         ray: &Ray<S>,

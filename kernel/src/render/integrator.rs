@@ -14,7 +14,7 @@ use glam::Vec3;
 
 /// Radiance of one pixel sample.
 ///
-/// Always inlined into the pixel loop on hosted targets, as [`super::Renderer::pixel`] is: left
+/// Always inlined into the pixel loop on hosted targets, as `Renderer::sampled_pixel` is: left
 /// to the optimiser, a large binary (the host's, with link-time optimisation) kept both out of
 /// line, and the calls and the values passed through memory cost a primary-only render about a
 /// tenth. Bare-metal targets keep the optimiser's choice, for flash (see `ray_data` in
@@ -122,6 +122,48 @@ pub(crate) fn sample_radiance<S: SpawnScalar>(
         current = Ray::<S>::new(S::array_to_vec(origin), dir_in_mode::<S>(dir.to_array()));
     }
     radiance
+}
+
+/// Radiance of pixel `(x, y)` when the plan needs only what camera rays see
+/// ([`RenderPlan::camera_rays_only`]): one ray through the pixel centre from the pinhole `eye`
+/// (see `CameraFrame::eye_ray`), a static scene, no lights to sample and nothing reflecting.
+/// Emitters, light surfaces seen directly and the background are then the whole picture;
+/// other surfaces are black. The same bits as [`sample_radiance`] under that plan (the same
+/// operations in the same order), without its sample stream, path state and bounce loop.
+#[cfg_attr(not(target_os = "none"), inline(always))]
+pub(crate) fn camera_ray_radiance<S: SpawnScalar>(
+    r: &Renderer<'_, S>,
+    eye: Option<&Ray<S>>,
+    x: u32,
+    y: u32,
+    stats: &mut RenderStats,
+) -> Vec3 {
+    let (_, d) = r.camera.ray(x as f32 + 0.5, y as f32 + 0.5, None);
+    stats.camera_rays += 1;
+    let Some(eye) = eye else {
+        return Vec3::ZERO;
+    };
+    let Ok(ray) = &eye.redirected_f32(d.to_array()) else {
+        return Vec3::ZERO;
+    };
+    let seen = match r.geometry.intersect(ray, 0.0, &mut NoStats) {
+        None => Vec3::from_array(r.background),
+        Some(hit) => match hit.surface {
+            Surface::Light { light } => light_seen(r, light, d.normalize_or_zero()),
+            Surface::Object { object, .. } => {
+                let material = r
+                    .geometry
+                    .object(object)
+                    .and_then(|o| r.materials.get(o.material as usize));
+                match material {
+                    Some(Material::Emissive { radiance }) => Vec3::from_array(*radiance),
+                    _ => return Vec3::ZERO,
+                }
+            }
+        },
+    };
+    // As `sample_radiance` adds it: zero radiance plus unit throughput times what is seen.
+    Vec3::ZERO + Vec3::ONE * seen
 }
 
 /// The path's direction at bounce `depth` as a unit vector: the camera's (depth 0) is

@@ -37,6 +37,7 @@ use crate::accel::bvh::BuildOptions;
 use crate::accel::grid::GridOptions;
 use crate::accel::kdtree::KdOptions;
 use crate::geom::spawn::SpawnScalar;
+use crate::geom::Ray;
 use camera::CameraFrame;
 use core::fmt;
 use geometry::Geometry;
@@ -92,6 +93,19 @@ pub struct RenderPlan {
 }
 
 impl RenderPlan {
+    /// True when camera rays are all a render casts: one sample at each pixel centre, a
+    /// pinhole, nothing moving, no lights and nothing reflecting. The renderer then runs a
+    /// first-hit loop without sample streams or a bounce loop (the same bits).
+    #[must_use]
+    pub const fn camera_rays_only(&self) -> bool {
+        self.pixel_centre
+            && !self.lens
+            && !self.motion
+            && !self.reflections
+            && self.point_lights == 0
+            && self.area_lights == 0
+    }
+
     fn derive<S: SpawnScalar>(scene: &Scene<'_, S>, settings: &Settings) -> Self {
         let used = |f: fn(&Material) -> bool| {
             scene
@@ -146,7 +160,11 @@ impl fmt::Display for RenderPlan {
             on(self.reflections),
             on(self.glossy),
             self.max_depth
-        )
+        )?;
+        if self.camera_rays_only() {
+            write!(f, "; camera rays only (first-hit loop)")?;
+        }
+        Ok(())
     }
 }
 
@@ -261,8 +279,24 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
     /// Mean linear radiance of pixel `(x, y)` over its samples (no bounds check: pixels
     /// outside the image are rendered as if the image extended there).
     #[must_use]
-    #[cfg_attr(not(target_os = "none"), inline(always))] // see `integrator::sample_radiance`
     pub fn pixel(&self, x: u32, y: u32, stats: &mut RenderStats) -> Rgb {
+        if self.plan.camera_rays_only() {
+            self.camera_ray_pixel(self.camera.eye_ray().as_ref(), x, y, stats)
+        } else {
+            self.sampled_pixel(x, y, stats)
+        }
+    }
+
+    /// [`Renderer::pixel`] under a plan of camera rays only, from the pinhole's eye ray.
+    #[cfg_attr(not(target_os = "none"), inline(always))] // see `integrator::sample_radiance`
+    fn camera_ray_pixel(&self, eye: Option<&Ray<S>>, x: u32, y: u32, stats: &mut RenderStats) -> Rgb {
+        // The mean of one sample, as `sampled_pixel` sums it.
+        (Vec3::ZERO + integrator::camera_ray_radiance(self, eye, x, y, stats)).to_array()
+    }
+
+    /// [`Renderer::pixel`] under any plan: every sample's path.
+    #[cfg_attr(not(target_os = "none"), inline(always))] // see `integrator::sample_radiance`
+    fn sampled_pixel(&self, x: u32, y: u32, stats: &mut RenderStats) -> Rgb {
         let index = y.wrapping_mul(self.settings.width).wrapping_add(x);
         let spp = self.settings.spp;
         let mut sum = Vec3::ZERO;
@@ -278,6 +312,29 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
         }
     }
 
+    /// Each pixel of `tile` in row-major order with its slot of the output: `put` stores the
+    /// colour. The per-pixel path is chosen once, from the plan.
+    #[cfg_attr(not(target_os = "none"), inline(always))]
+    fn fill<T>(
+        &self,
+        tile: Tile,
+        slots: impl Iterator<Item = T>,
+        stats: &mut RenderStats,
+        mut put: impl FnMut(T, Rgb),
+    ) {
+        let pixels = tile.pixels().zip(slots);
+        if self.plan.camera_rays_only() {
+            let eye = self.camera.eye_ray::<S>();
+            for ((x, y), slot) in pixels {
+                put(slot, self.camera_ray_pixel(eye.as_ref(), x, y, stats));
+            }
+        } else {
+            for ((x, y), slot) in pixels {
+                put(slot, self.sampled_pixel(x, y, stats));
+            }
+        }
+    }
+
     /// Renders `tile` as linear RGB into `out` (row-major within the tile, `width·height`
     /// entries).
     ///
@@ -286,9 +343,7 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
     pub fn render_tile(&self, tile: Tile, out: &mut [Rgb]) -> Result<RenderStats, SceneError> {
         let n = self.check_tile(tile, out.len(), 1)?;
         let mut stats = RenderStats::default();
-        for ((x, y), px) in tile.pixels().zip(out.iter_mut().take(n)) {
-            *px = self.pixel(x, y, &mut stats);
-        }
+        self.fill(tile, out.iter_mut().take(n), &mut stats, |px, c| *px = c);
         Ok(stats)
     }
 
@@ -302,12 +357,12 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
     pub fn render_tile_srgb8(&self, tile: Tile, out: &mut [u8]) -> Result<RenderStats, SceneError> {
         let n = self.check_tile(tile, out.len(), 3)?;
         let mut stats = RenderStats::default();
-        for ((x, y), px) in tile.pixels().zip(out.chunks_exact_mut(3).take(n)) {
-            let c = self.pixel(x, y, &mut stats);
+        let slots = out.chunks_exact_mut(3).take(n);
+        self.fill(tile, slots, &mut stats, |px, c| {
             for (b, v) in px.iter_mut().zip(c) {
                 *b = encode_srgb8(v);
             }
-        }
+        });
         Ok(stats)
     }
 

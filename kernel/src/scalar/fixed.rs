@@ -203,24 +203,26 @@ impl FixedRay {
         for x in origin {
             check_raw(x.0).map_err(RayError::Origin)?;
         }
+        let o = origin.map(|x| x.0 as i64);
         let mut r = Self {
-            origin: [0; 3],
+            origin: o,
             dir: [0; 3],
             recip: [0; 3],
-            o_lo: [0; 3],
-            o_hi: [0; 3],
-        };
-        for i in 0..3 {
-            let o = origin[i].0 as i64;
-            let d = libm::round(unit[i] * DIR_ONE) as i64;
-            r.origin[i] = o;
-            r.dir[i] = d;
-            r.recip[i] = if d == 0 { i64::MAX } else { (1i64 << 62) / d };
             // The box grows by one raw unit on each side, as seen from these origins.
-            r.o_lo[i] = o + 1;
-            r.o_hi[i] = o - 1;
-        }
+            o_lo: o.map(|x| x + 1),
+            o_hi: o.map(|x| x - 1),
+        };
+        r.set_dir(unit);
         Ok(r)
+    }
+
+    /// Sets the direction (Q2.30, rounded from `unit`) and its reciprocals.
+    #[inline]
+    fn set_dir(&mut self, unit: [f64; 3]) {
+        self.dir = unit.map(|u| libm::round(u * DIR_ONE) as i64);
+        self.recip = self
+            .dir
+            .map(|d| if d == 0 { i64::MAX } else { (1i64 << 62) / d });
     }
 
     fn moved(&self, origin: [I16F16; 3]) -> Result<Self, RayError> {
@@ -332,6 +334,13 @@ impl Scalar for I16F16 {
     }
     fn ray_moved(ray: &FixedRay, origin: [Self; 3]) -> Result<FixedRay, RayError> {
         ray.moved(origin)
+    }
+    #[inline]
+    fn ray_redirected_f32(ray: &FixedRay, dir: [f32; 3]) -> Result<FixedRay, RayError> {
+        let unit = super::float::unit_dir_f64([dir[0] as f64, dir[1] as f64, dir[2] as f64])?;
+        let mut r = *ray;
+        r.set_dir(unit);
+        Ok(r)
     }
     fn ray_origin(ray: &FixedRay) -> [Self; 3] {
         ray.origin.map(|x| I16F16(x as i32))

@@ -103,14 +103,25 @@ impl FloatRay {
         for &x in &origin {
             check_coord(x).map_err(RayError::Origin)?;
         }
+        let (o_lo, o_hi) = Self::shifted_origins(origin);
+        Self::along(origin, o_lo, o_hi, dir)
+    }
+
+    /// The ray from a checked origin (with its shifted copies) along `dir`: everything that
+    /// depends on the direction. Inlined as [`FloatRay::new`] is.
+    #[cfg_attr(not(target_os = "none"), inline(always))]
+    fn along(
+        origin: [f32; 3],
+        o_lo: [f32; 4],
+        o_hi: [f32; 4],
+        dir: [f32; 3],
+    ) -> Result<Self, RayError> {
         let d64 = unit_dir_f64([dir[0] as f64, dir[1] as f64, dir[2] as f64])?;
         let dir = [d64[0] as f32, d64[1] as f32, d64[2] as f32];
-
-        let (o_lo, o_hi) = Self::shifted_origins(origin);
-        let mut inv = [0.0; 4];
-        for i in 0..4 {
-            inv[i] = 1.0 / dir[i.min(2)];
-        }
+        // Four quotients in one vector division (each lane the same IEEE quotient).
+        let inv = F4::splat(1.0)
+            .div(F4::new([dir[0], dir[1], dir[2], dir[2]]))
+            .to_array();
 
         // Watertight test: kz is the dominant axis; swapping kx/ky keeps the winding.
         let a = [abs(dir[0]), abs(dir[1]), abs(dir[2])];
@@ -329,6 +340,10 @@ impl Scalar for f32 {
     }
     fn ray_moved(ray: &FloatRay, origin: [f32; 3]) -> Result<FloatRay, RayError> {
         ray.moved(origin)
+    }
+    #[cfg_attr(not(target_os = "none"), inline(always))]
+    fn ray_redirected_f32(ray: &FloatRay, dir: [f32; 3]) -> Result<FloatRay, RayError> {
+        FloatRay::along(ray.origin, ray.o_lo, ray.o_hi, dir)
     }
     fn ray_origin(ray: &FloatRay) -> [f32; 3] {
         ray.origin

@@ -11,9 +11,11 @@
 mod sse {
     // SAFETY (every `unsafe` block below): these intrinsics have no precondition beyond the
     // CPU supporting SSE/SSE2, which `cfg(target_feature = "sse2")` guarantees at compile
-    // time (it is part of the x86_64 baseline). None of them touches memory.
+    // time (it is part of the x86_64 baseline). None of them touches memory. `to_array`'s
+    // transmute copies the 16 bytes of an `__m128` into a `[f32; 4]` of the same size, and
+    // every bit pattern is a valid `f32`.
     use arch::{
-        __m128, _mm_cmple_ps, _mm_cvtss_f32, _mm_max_ps, _mm_min_ps, _mm_movehl_ps,
+        __m128, _mm_cmple_ps, _mm_cvtss_f32, _mm_div_ps, _mm_max_ps, _mm_min_ps, _mm_movehl_ps,
         _mm_movemask_ps, _mm_mul_ps, _mm_set1_ps, _mm_setr_ps, _mm_shuffle_ps, _mm_sub_ps,
         _mm_unpackhi_ps, _mm_unpacklo_ps,
     };
@@ -42,6 +44,15 @@ mod sse {
         #[inline(always)]
         pub(crate) fn mul(self, o: Self) -> Self {
             Self(unsafe { _mm_mul_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        pub(crate) fn div(self, o: Self) -> Self {
+            Self(unsafe { _mm_div_ps(self.0, o.0) })
+        }
+        /// The lanes in order.
+        #[inline(always)]
+        pub(crate) fn to_array(self) -> [f32; 4] {
+            unsafe { core::mem::transmute::<__m128, [f32; 4]>(self.0) }
         }
         /// Per lane `if a < b { a } else { b }` (the second operand when unordered).
         #[inline(always)]
@@ -110,6 +121,14 @@ mod portable {
         #[inline(always)]
         pub(crate) fn mul(self, o: Self) -> Self {
             self.zip(o, |a, b| a * b)
+        }
+        #[inline(always)]
+        pub(crate) fn div(self, o: Self) -> Self {
+            self.zip(o, |a, b| a / b)
+        }
+        #[inline(always)]
+        pub(crate) fn to_array(self) -> [f32; 4] {
+            self.0
         }
         #[inline(always)]
         pub(crate) fn min(self, o: Self) -> Self {
@@ -197,6 +216,12 @@ mod tests {
             };
             same(pa.sub(pb), sa.sub(sb), "sub");
             same(pa.mul(pb), sa.mul(sb), "mul");
+            same(pa.div(pb), sa.div(sb), "div");
+            assert_eq!(
+                pa.to_array().map(f32::to_bits),
+                sa.to_array().map(f32::to_bits),
+                "to_array {a:?}"
+            );
             same(pa.min(pb), sa.min(sb), "min");
             same(pa.max(pb), sa.max(sb), "max");
             same(pa.unpack_lo(pb), sa.unpack_lo(sb), "unpack_lo");

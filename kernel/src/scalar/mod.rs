@@ -87,6 +87,13 @@ pub trait Scalar:
     /// # Errors
     /// [`RayError::Origin`] for an unusable origin.
     fn ray_moved(ray: &Self::RayData, origin: [Self; 3]) -> Result<Self::RayData, RayError>;
+    /// The ray from the same origin along another direction given in `f32`: the same bits as
+    /// [`Scalar::ray_data_from_f32`] with this ray's origin, without checking and preparing the
+    /// origin again.
+    ///
+    /// # Errors
+    /// [`RayError::ZeroDirection`] and [`RayError::NonFiniteDirection`].
+    fn ray_redirected_f32(ray: &Self::RayData, dir: [f32; 3]) -> Result<Self::RayData, RayError>;
     /// The ray origin.
     fn ray_origin(ray: &Self::RayData) -> [Self; 3];
     /// The (unit-length) ray direction, rounded to this mode.
