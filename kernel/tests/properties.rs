@@ -675,7 +675,10 @@ where
     if format!("{want:?}") == format!("{got:?}") {
         Ok(())
     } else {
-        Err(format!("{}: from_f32 {want:?}\nredirected {got:?}", S::NAME))
+        Err(format!(
+            "{}: from_f32 {want:?}\nredirected {got:?}",
+            S::NAME
+        ))
     }
 }
 

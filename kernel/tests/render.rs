@@ -580,7 +580,10 @@ fn plans_follow_the_scenes() {
     );
     // Its two point lights still need shadow rays; without them only camera rays are left.
     assert!(!b.camera_rays_only() && !text.contains("camera rays only"));
-    let unlit = plan(&SceneData { lights: &[], ..bare });
+    let unlit = plan(&SceneData {
+        lights: &[],
+        ..bare
+    });
     assert!(unlit.camera_rays_only());
     assert!(unlit.to_string().contains("camera rays only"), "{unlit}");
 }
@@ -636,7 +639,13 @@ fn camera_rays_only_case<S: SpawnScalar>(d: &SceneData<'_>) {
             let r = Renderer::new(scene, settings, AccelChoice::default(), memory.lend()).unwrap();
             assert_eq!(r.plan().camera_rays_only(), lights.is_empty(), "{}", d.name);
             let image = render(scene, settings, AccelChoice::default()).unwrap();
-            images.push(image.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>());
+            images.push(
+                image
+                    .iter()
+                    .flatten()
+                    .map(|x| x.to_bits())
+                    .collect::<Vec<_>>(),
+            );
         });
     }
     let emitters = images[0].iter().filter(|&&b| b != 0).count();

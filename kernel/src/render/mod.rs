@@ -289,7 +289,13 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
 
     /// [`Renderer::pixel`] under a plan of camera rays only, from the pinhole's eye ray.
     #[cfg_attr(not(target_os = "none"), inline(always))] // see `integrator::sample_radiance`
-    fn camera_ray_pixel(&self, eye: Option<&Ray<S>>, x: u32, y: u32, stats: &mut RenderStats) -> Rgb {
+    fn camera_ray_pixel(
+        &self,
+        eye: Option<&Ray<S>>,
+        x: u32,
+        y: u32,
+        stats: &mut RenderStats,
+    ) -> Rgb {
         // The mean of one sample, as `sampled_pixel` sums it.
         (Vec3::ZERO + integrator::camera_ray_radiance(self, eye, x, y, stats)).to_array()
     }
