@@ -83,9 +83,8 @@ impl CameraFrame {
         })
     }
 
-    /// The pinhole's ray along the view direction: every pinhole camera ray starts where it
-    /// does, so [`Ray::redirected_f32`] turns it into any of them. `None` if the eye is
-    /// outside the mode's range (no camera ray is usable then).
+    /// The pinhole's ray along the view direction; `None` if the eye is outside the mode's
+    /// range (no camera ray is usable then).
     pub(crate) fn eye_ray<S: Scalar>(&self) -> Option<Ray<S>> {
         Ray::<S>::from_f32(self.eye.to_array(), self.w.to_array(), 0.0, f32::INFINITY).ok()
     }

@@ -63,12 +63,8 @@ pub(crate) fn sample_radiance<S: SpawnScalar>(
             }
             Surface::Object { object, .. } => object,
         };
-        let material = r
-            .geometry
-            .object(object)
-            .and_then(|o| r.materials.get(o.material as usize));
         // Emitters end the path: no surface point needed.
-        let material = match material {
+        let material = match material_of(r, object) {
             None => break,
             Some(Material::Emissive { radiance: e }) => {
                 radiance += throughput * Vec3::from_array(*e);
@@ -125,22 +121,21 @@ pub(crate) fn sample_radiance<S: SpawnScalar>(
 }
 
 /// Radiance of pixel `(x, y)` when the plan needs only what camera rays see
-/// ([`RenderPlan::camera_rays_only`]): one ray through the pixel centre from the pinhole `eye`
-/// (see `CameraFrame::eye_ray`), a static scene, no lights to sample and nothing reflecting.
+/// ([`RenderPlan::camera_rays_only`]): one ray through the pixel centre from the renderer's
+/// eye ray, a static scene, no lights to sample and nothing reflecting.
 /// Emitters, light surfaces seen directly and the background are then the whole picture;
 /// other surfaces are black. The same bits as [`sample_radiance`] under that plan (the same
 /// operations in the same order), without its sample stream, path state and bounce loop.
 #[cfg_attr(not(target_os = "none"), inline(always))]
 pub(crate) fn camera_ray_radiance<S: SpawnScalar>(
     r: &Renderer<'_, S>,
-    eye: Option<&Ray<S>>,
     x: u32,
     y: u32,
     stats: &mut RenderStats,
 ) -> Vec3 {
     let (_, d) = r.camera.ray(x as f32 + 0.5, y as f32 + 0.5, None);
     stats.camera_rays += 1;
-    let Some(eye) = eye else {
+    let Some(eye) = &r.eye_ray else {
         return Vec3::ZERO;
     };
     let Ok(ray) = &eye.redirected_f32(d.to_array()) else {
@@ -150,20 +145,22 @@ pub(crate) fn camera_ray_radiance<S: SpawnScalar>(
         None => Vec3::from_array(r.background),
         Some(hit) => match hit.surface {
             Surface::Light { light } => light_seen(r, light, d.normalize_or_zero()),
-            Surface::Object { object, .. } => {
-                let material = r
-                    .geometry
-                    .object(object)
-                    .and_then(|o| r.materials.get(o.material as usize));
-                match material {
-                    Some(Material::Emissive { radiance }) => Vec3::from_array(*radiance),
-                    _ => return Vec3::ZERO,
-                }
-            }
+            Surface::Object { object, .. } => match material_of(r, object) {
+                Some(Material::Emissive { radiance }) => Vec3::from_array(*radiance),
+                _ => return Vec3::ZERO,
+            },
         },
     };
     // As `sample_radiance` adds it: zero radiance plus unit throughput times what is seen.
     Vec3::ZERO + Vec3::ONE * seen
+}
+
+/// Object `object`'s material (`None` only for an index the renderer's checks rule out).
+#[inline]
+fn material_of<'r, S: SpawnScalar>(r: &'r Renderer<'_, S>, object: usize) -> Option<&'r Material> {
+    r.geometry
+        .object(object)
+        .and_then(|o| r.materials.get(o.material as usize))
 }
 
 /// The path's direction at bounce `depth` as a unit vector: the camera's (depth 0) is

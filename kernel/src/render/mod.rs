@@ -234,6 +234,10 @@ pub struct Renderer<'a, S: SpawnScalar> {
     lights: &'a [Light],
     background: Rgb,
     camera: CameraFrame,
+    /// The pinhole's ray along the view direction (`None` if the eye is outside the mode's
+    /// range): every pinhole camera ray starts where it does, so the first-hit loop turns it
+    /// into each of them with [`Ray::redirected_f32`].
+    eye_ray: Option<Ray<S>>,
     settings: Settings,
     sampler: Sampler,
     plan: RenderPlan,
@@ -265,6 +269,7 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
             materials: scene.materials,
             lights: scene.lights,
             background: scene.background,
+            eye_ray: camera.eye_ray(),
             camera,
             settings,
             sampler: Sampler::new(settings.sampler, settings.spp, settings.seed),
@@ -289,23 +294,17 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
     #[must_use]
     pub fn pixel(&self, x: u32, y: u32, stats: &mut RenderStats) -> Rgb {
         if self.plan.camera_rays_only() {
-            self.camera_ray_pixel(self.camera.eye_ray().as_ref(), x, y, stats)
+            self.camera_ray_pixel(x, y, stats)
         } else {
             self.sampled_pixel(x, y, stats)
         }
     }
 
-    /// [`Renderer::pixel`] under a plan of camera rays only, from the pinhole's eye ray.
+    /// [`Renderer::pixel`] under a plan of camera rays only.
     #[cfg_attr(not(target_os = "none"), inline(always))] // see `integrator::sample_radiance`
-    fn camera_ray_pixel(
-        &self,
-        eye: Option<&Ray<S>>,
-        x: u32,
-        y: u32,
-        stats: &mut RenderStats,
-    ) -> Rgb {
+    fn camera_ray_pixel(&self, x: u32, y: u32, stats: &mut RenderStats) -> Rgb {
         // The mean of one sample, as `sampled_pixel` sums it.
-        (Vec3::ZERO + integrator::camera_ray_radiance(self, eye, x, y, stats)).to_array()
+        (Vec3::ZERO + integrator::camera_ray_radiance(self, x, y, stats)).to_array()
     }
 
     /// [`Renderer::pixel`] under any plan: every sample's path.
@@ -337,9 +336,8 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
         mut put: impl FnMut(T, Rgb),
     ) {
         if self.plan.camera_rays_only() {
-            let eye = self.camera.eye_ray::<S>();
             tile.for_each_pixel(slots, |x, y, slot| {
-                put(slot, self.camera_ray_pixel(eye.as_ref(), x, y, stats));
+                put(slot, self.camera_ray_pixel(x, y, stats));
             });
         } else {
             tile.for_each_pixel(slots, |x, y, slot| {

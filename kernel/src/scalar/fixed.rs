@@ -329,17 +329,15 @@ impl Scalar for I16F16 {
         for i in 0..3 {
             o[i] = Self::coord_from_f32(origin[i]).map_err(RayError::Origin)?;
         }
-        let unit = super::float::unit_dir_f64([dir[0] as f64, dir[1] as f64, dir[2] as f64])?;
-        FixedRay::new(o, unit)
+        FixedRay::new(o, super::float::unit_dir_from_f32(dir)?)
     }
     fn ray_moved(ray: &FixedRay, origin: [Self; 3]) -> Result<FixedRay, RayError> {
         ray.moved(origin)
     }
     #[inline]
     fn ray_redirected_f32(ray: &FixedRay, dir: [f32; 3]) -> Result<FixedRay, RayError> {
-        let unit = super::float::unit_dir_f64([dir[0] as f64, dir[1] as f64, dir[2] as f64])?;
         let mut r = *ray;
-        r.set_dir(unit);
+        r.set_dir(super::float::unit_dir_from_f32(dir)?);
         Ok(r)
     }
     fn ray_origin(ray: &FixedRay) -> [Self; 3] {

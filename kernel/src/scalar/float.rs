@@ -96,6 +96,12 @@ pub(super) fn unit_dir_f64(d: [f64; 3]) -> Result<[f64; 3], RayError> {
     Ok([s[0] * inv_len, s[1] * inv_len, s[2] * inv_len])
 }
 
+/// [`unit_dir_f64`] of an `f32` direction (every `f32` is exact in `f64`).
+#[cfg_attr(not(target_os = "none"), inline(always))]
+pub(super) fn unit_dir_from_f32(d: [f32; 3]) -> Result<[f64; 3], RayError> {
+    unit_dir_f64(d.map(f64::from))
+}
+
 impl FloatRay {
     /// Inlined into the ray constructors: see `ray_data` in the `Scalar` impl below.
     #[cfg_attr(not(target_os = "none"), inline(always))]
@@ -116,7 +122,7 @@ impl FloatRay {
         o_hi: [f32; 4],
         dir: [f32; 3],
     ) -> Result<Self, RayError> {
-        let d64 = unit_dir_f64([dir[0] as f64, dir[1] as f64, dir[2] as f64])?;
+        let d64 = unit_dir_from_f32(dir)?;
         let dir = [d64[0] as f32, d64[1] as f32, d64[2] as f32];
         // Four quotients in one vector division (each lane the same IEEE quotient).
         let inv = F4::splat(1.0)

@@ -32,7 +32,7 @@ pub trait Scalar:
     /// The vector type of the public API: `glam::Vec3` for `f32`, [`crate::Vec3x`] for fixed point.
     type Vec3: Copy + Debug;
     /// Per-ray data precomputed once by [`crate::Ray`]'s constructors for the box and primitive tests.
-    type RayData: Copy + Debug;
+    type RayData: Copy + Debug + Send + Sync;
 
     /// Zero.
     const ZERO: Self;

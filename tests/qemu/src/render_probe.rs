@@ -2,7 +2,7 @@
 //! `panic_never_render_fixed` (`I16F16`), as `panic_never.rs` does for the BVH: the built-in
 //! scene data converted into caller buffers, `Renderer::new` with every accelerator, every
 //! render entry point, on values the optimiser cannot see (`black_box`: scene, settings,
-//! buffer lengths, tiles), linked with a panic handler that calls a function nobody defines.
+//! buffer lengths, tiles), linked with the panic handler of `panic_check.rs`.
 //! One mode per binary: both in one no longer fit the Cortex-M0's 256 KB of flash. Build:
 //! `cargo build --release --bin panic_never_render --features panic-check` in tests/qemu
 //! (`cargo xtask panic-check`). Never run: it only has to link.
@@ -91,24 +91,4 @@ pub fn run<S: SpawnScalar>() -> ! {
     loop {
         cortex_m::asm::nop();
     }
-}
-
-/// With feature `list-panics` the handler spins instead, so the binary links and
-/// `cargo xtask panic-check` can list the functions that still call into the panic machinery.
-#[cfg(feature = "list-panics")]
-#[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
-    loop {
-        cortex_m::asm::nop();
-    }
-}
-
-#[cfg(not(feature = "list-panics"))]
-#[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
-    extern "C" {
-        fn kernel_has_a_reachable_panic_path() -> !;
-    }
-    // SAFETY: never defined; any call that survives optimisation fails the link, on purpose.
-    unsafe { kernel_has_a_reachable_panic_path() }
 }

@@ -2,6 +2,8 @@
 #![no_std]
 #![no_main]
 
+#[path = "../panic_check.rs"]
+mod panic_check;
 #[path = "../render_probe.rs"]
 mod render_probe;
 

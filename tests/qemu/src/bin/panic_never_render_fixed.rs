@@ -4,6 +4,8 @@
 
 use raykernel::I16F16;
 
+#[path = "../panic_check.rs"]
+mod panic_check;
 #[path = "../render_probe.rs"]
 mod render_probe;
 
