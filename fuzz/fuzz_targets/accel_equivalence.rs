@@ -320,6 +320,7 @@ fn check_mode<S: Mode>(tris_f32: &[[[f32; 3]; 3]], rays_in: &[RayIn]) {
             builds.push(BuildOptions {
                 builder,
                 max_leaf_size,
+                reinsertion: true,
             });
         }
     }

@@ -116,6 +116,7 @@ pub fn variants() -> Vec<Variant> {
                     [1, 4].map(|max_leaf_size| BuildOptions {
                         builder,
                         max_leaf_size,
+                        reinsertion: true,
                     })
                 })
                 .collect(),

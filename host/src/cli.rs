@@ -133,6 +133,9 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 4,
           value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_LEAF_SIZE)))]
     pub leaf: u32,
+    /// Skip the BVH's reinsertion pass (keep the tree exactly as the builder split it).
+    #[arg(long)]
+    pub no_reinsertion: bool,
     /// Tile size in pixels (square tiles, rendered in parallel).
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub tile: u32,
@@ -278,6 +281,9 @@ pub struct TraceArgs {
     #[arg(long, default_value_t = 4,
           value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_LEAF_SIZE)))]
     pub leaf: u32,
+    /// Skip the BVH's reinsertion pass (keep the tree exactly as the builder split it).
+    #[arg(long)]
+    pub no_reinsertion: bool,
     /// Trace only rays 0, K, 2K, ... (hit files of equal stride are comparable).
     #[arg(long, value_name = "K", default_value_t = 1,
           value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
@@ -408,6 +414,8 @@ pub struct TraceReport {
     pub mode: &'static str,
     /// Largest leaf.
     pub leaf: u32,
+    /// The BVH's reinsertion pass was asked for (BVH only).
+    pub reinsertion: bool,
     /// Primitives permuted into leaf order at build time.
     pub leaf_order: bool,
     /// Full runs (build + trace); the times are medians over them.
@@ -525,6 +533,7 @@ pub fn run_render(args: &RenderArgs) -> Result<RenderReport, Error> {
         BuildOptions {
             builder: args.builder.into(),
             max_leaf_size: args.leaf,
+            reinsertion: !args.no_reinsertion,
         },
     );
     let the_plan = plan(&data, settings, mode).map_err(|e| spec.explain(&e, mode_name(mode)))?;
@@ -645,6 +654,7 @@ pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
         build: BuildOptions {
             builder: args.builder.into(),
             max_leaf_size: args.leaf,
+            reinsertion: !args.no_reinsertion,
         },
         mode: args.mode,
         stride: args.stride,
@@ -669,6 +679,7 @@ pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
         builder: (args.accel == AccelKind::Bvh).then(|| BuilderKind::from(args.builder).name()),
         mode: args.mode.name(),
         leaf: args.leaf,
+        reinsertion: args.accel == AccelKind::Bvh && !args.no_reinsertion,
         leaf_order: args.leaf_order,
         runs: args.runs,
         stride: args.stride,

@@ -96,6 +96,7 @@ fn args(s: &Scene, accel: AccelKind, builder: Builder, mode: Mode, leaf: u32) ->
         builder,
         mode,
         leaf,
+        no_reinsertion: false,
         stride: 1,
         runs: 1,
         leaf_order: false,

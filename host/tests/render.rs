@@ -48,6 +48,7 @@ fn small(scene: Option<PathBuf>, out: PathBuf, mode: Mode) -> RenderArgs {
         threads: Some(2),
         accel: AccelKind::Bvh,
         builder: Builder::Sah,
+        no_reinsertion: false,
         leaf: 4,
         tile: 16,
     }

@@ -245,6 +245,7 @@ fn leaf_size_cases<S: TestScalar>() {
             let opts = BuildOptions {
                 builder,
                 max_leaf_size: bad,
+                reinsertion: true,
             };
             assert_eq!(
                 build_err(&prims, nodes_needed(10), 10, opts),
@@ -256,6 +257,7 @@ fn leaf_size_cases<S: TestScalar>() {
         let opts = BuildOptions {
             builder,
             max_leaf_size: MAX_LEAF_SIZE,
+            reinsertion: true,
         };
         with_bvh::<S, _, _>(&prims, opts, |bvh| {
             let stats = bvh.validate().unwrap();
@@ -636,10 +638,13 @@ fn depth_cap_cases<S: TestScalar>(top: i32, levels: usize) {
     }
     check_against_linear::<S>("exponential centroids", &v, &rays);
     let prims: Vec<Triangle<S>> = v.iter().map(|&t| Triangle::from_f32(t).unwrap()).collect();
+    // The builder's own depth (reinsertion, which may only keep within the cap, is checked
+    // above through `all_options`).
     for max_leaf_size in [1, 4] {
         let opts = BuildOptions {
             builder: BuilderKind::Midpoint,
             max_leaf_size,
+            reinsertion: false,
         };
         with_bvh::<S, _, _>(&prims, opts, |bvh| {
             let depth = bvh.depth() as usize;

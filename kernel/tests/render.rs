@@ -888,6 +888,7 @@ fn buffers_and_tiles_are_checked_exactly() {
     let bvh = AccelChoice::Bvh(BuildOptions {
         builder: BuilderKind::Median,
         max_leaf_size: 1,
+        reinsertion: true,
     });
     let kd = AccelChoice::KdTree(KdOptions::default());
     let grid = AccelChoice::Grid(GridOptions::default());

@@ -552,6 +552,7 @@ fn accels<'a, S: Mode>(tris: &'a [Triangle<S>], arenas: &'a mut Arenas<S>) -> Ac
     let opts = |builder, max_leaf_size| BuildOptions {
         builder,
         max_leaf_size,
+        reinsertion: true,
     };
     let build = |nodes, ids, o: BuildOptions| {
         let b = Bvh::build(tris, nodes, ids, o).unwrap_or_else(|e| panic!("build {o:?}: {e}"));
@@ -1523,6 +1524,7 @@ fn bad_input<S: Mode>() {
             let o = BuildOptions {
                 builder,
                 max_leaf_size: 1,
+                reinsertion: true,
             };
             check(
                 format!("{n} prims, nodes short by one ({builder:?})"),
@@ -1558,6 +1560,7 @@ fn bad_input<S: Mode>() {
                 let o = BuildOptions {
                     builder: BuilderKind::Sah,
                     max_leaf_size: leaf,
+                    reinsertion: true,
                 };
                 Bvh::build(&tris, &mut nodes, &mut ids, o).err()
                     == Some(BuildError::BadLeafSize {

@@ -246,6 +246,7 @@ fn builders_leaf4() -> Vec<BuildOptions> {
         .map(|builder| BuildOptions {
             builder,
             max_leaf_size: 4,
+            reinsertion: true,
         })
         .collect()
 }

@@ -357,6 +357,7 @@ pub fn tree_case<S: Bits>(builder: BuilderKind) -> Result<u64, Fail> {
     let options = BuildOptions {
         builder,
         max_leaf_size: 4,
+        reinsertion: true,
     };
     let bvh = Bvh::build(&tris, &mut nodes, &mut ids, options).map_err(|_| Fail::Build)?;
     bvh.validate().map_err(|_| Fail::Invalid)?;

@@ -441,6 +441,7 @@ fn arena_per_tri(tris: &[Triangle<f32>]) -> Vec<(BuilderKind, f64)> {
         let options = BuildOptions {
             builder,
             max_leaf_size: 4,
+            reinsertion: true,
         };
         if let Ok(bvh) = Bvh::build(tris, &mut nodes, &mut ids, options) {
             out.push((builder, bvh.bytes_used() as f64 / tris.len() as f64));

@@ -265,14 +265,18 @@ where
     f(&tree)
 }
 
-/// Every (builder, leaf size) combination the differential tests cover.
+/// Every (builder, leaf size) combination the differential tests cover, each with
+/// reinsertion, plus SAH without it.
 pub fn all_options() -> impl Iterator<Item = BuildOptions> {
-    BuilderKind::ALL.into_iter().flat_map(|builder| {
+    let with = BuilderKind::ALL.map(|builder| (builder, true));
+    let kinds = with.into_iter().chain([(BuilderKind::Sah, false)]);
+    kinds.flat_map(|(builder, reinsertion)| {
         LEAF_SIZES
             .into_iter()
             .map(move |max_leaf_size| BuildOptions {
                 builder,
                 max_leaf_size,
+                reinsertion,
             })
     })
 }

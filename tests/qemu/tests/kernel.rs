@@ -160,6 +160,7 @@ fn bvh_vs_linear<S: Bits>(linear_golden: &str) {
             let options = BuildOptions {
                 builder,
                 max_leaf_size,
+                reinsertion: true,
             };
             let bvh = Bvh::build(&tris, &mut nodes, &mut ids, options);
             defmt::assert!(
@@ -237,6 +238,7 @@ fn error_cases<S: Scalar>() {
     for max_leaf_size in [0, raykernel::bvh::MAX_LEAF_SIZE + 1] {
         let o = BuildOptions {
             max_leaf_size,
+            reinsertion: true,
             ..opt
         };
         let e = Bvh::build(&tris, &mut nodes, &mut ids, o).err();

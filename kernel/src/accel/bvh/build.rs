@@ -185,6 +185,14 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
             }
         }
     }
+    if options.reinsertion {
+        if let Some(depth) = nodes
+            .get_mut(..needed)
+            .and_then(|arena| super::optimize::reinsert(arena, used, ids))
+        {
+            deepest = depth;
+        }
+    }
     for node in nodes.iter_mut().take(used) {
         let (lo, hi) = S::pad_bounds(node.lo, node.hi);
         node.lo = lo;
