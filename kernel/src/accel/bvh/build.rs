@@ -16,8 +16,35 @@ const BINS: usize = 32;
 /// SAH cost of visiting a node, relative to one primitive test.
 const TRAVERSAL_COST: f32 = 1.0;
 
-/// Builds into `nodes`/`ids`; returns (nodes used, depth of the deepest leaf).
+/// Builds into `nodes`/`ids`: the top-down split, the optional reinsertion pass, then bounds
+/// padded for traversal. Returns (nodes used, depth of the deepest leaf).
 pub(super) fn build<S: Scalar, P: Primitive<S>>(
+    prims: &[P],
+    nodes: &mut [Node<S>],
+    ids: &mut [u32],
+    options: BuildOptions,
+) -> Result<(usize, u32), BuildError> {
+    let (used, mut deepest) = split_top_down(prims, nodes, ids, options)?;
+    if options.reinsertion {
+        let arena = nodes.get_mut(..nodes_needed(prims.len()));
+        if let (Some(arena), Some(ids)) = (arena, ids.get_mut(..prims.len())) {
+            if let Some(depth) = super::optimize::reinsert(arena, used, ids) {
+                deepest = depth;
+            }
+        }
+    }
+    for node in nodes.iter_mut().take(used) {
+        let (lo, hi) = S::pad_bounds(node.lo, node.hi);
+        node.lo = lo;
+        node.hi = hi;
+    }
+    Ok((used, deepest))
+}
+
+/// The top-down build into `nodes`/`ids`, bounds unpadded. Not inlined, so that its frame (bins,
+/// pending stack) is gone before reinsertion runs: the M0 has little stack.
+#[inline(never)]
+fn split_top_down<S: Scalar, P: Primitive<S>>(
     prims: &[P],
     nodes: &mut [Node<S>],
     ids: &mut [u32],
@@ -184,19 +211,6 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
                 sp += 1;
             }
         }
-    }
-    if options.reinsertion {
-        if let Some(depth) = nodes
-            .get_mut(..needed)
-            .and_then(|arena| super::optimize::reinsert(arena, used, ids))
-        {
-            deepest = depth;
-        }
-    }
-    for node in nodes.iter_mut().take(used) {
-        let (lo, hi) = S::pad_bounds(node.lo, node.hi);
-        node.lo = lo;
-        node.hi = hi;
     }
     Ok((used, deepest))
 }

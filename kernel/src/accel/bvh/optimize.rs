@@ -8,7 +8,7 @@
 //! area, and moves it there if that lowers the tree's cost. Leaves never change, so the cost
 //! to lower is the summed surface area of the inner nodes.
 //!
-//! Candidates are the nodes with the largest boxes, in rounds: a probe round over the largest
+//! Candidates are the nodes with the largest boxes (by quarter-octave size class), in rounds: a probe round over the largest
 //! 1% (at least 64 nodes), then up to three over the largest 10%, stopping as soon as a round
 //! lowers the cost by less than 0.2%. Trees a top-down build already got right (closed
 //! meshes such as the bunny) stop after the probe.
@@ -37,6 +37,9 @@ const MIN_CANDIDATES: usize = 64;
 const MIN_ROUND_GAIN: f32 = 0.002;
 /// A move must lower the cost by more than this fraction of what it removes.
 const MIN_GAIN: f32 = 1e-5;
+/// Area buckets for candidate selection (see [`Tree::candidate_threshold`]).
+const BUCKETS: usize = 64;
+type Histogram = [u32; BUCKETS];
 /// Marks the root pair's missing parent.
 const NO_PARENT: u32 = u32::MAX;
 
@@ -61,7 +64,7 @@ pub(super) fn reinsert<S: Scalar>(
         pairs: scratch,
     };
     t.link();
-    let mut histogram = [0u32; 256];
+    let mut histogram: Histogram = [0; BUCKETS];
     let mut moved = false;
     for share in ROUND_SHARES {
         let cost = t.cost();
@@ -70,7 +73,7 @@ pub(super) fn reinsert<S: Scalar>(
         let mut gained = 0.0f32;
         for slot in FIRST_PAIR..used {
             let Some(node) = t.nodes.get(slot) else { break };
-            if exponent(half_area(&node.bounds())) >= threshold {
+            if size_class(half_area(&node.bounds())) >= threshold {
                 gained += t.try_move(slot);
             }
         }
@@ -133,9 +136,10 @@ fn walk_mut<S: Scalar>(nodes: &mut [Node<S>], mut visit: impl FnMut(&mut Node<S>
     }
 }
 
-/// The biased exponent of a non-negative `f32`: a monotone bucket of its size.
-fn exponent(x: f32) -> usize {
-    ((x.to_bits() >> 23) & 0xff) as usize
+/// A monotone size class of a non-negative `f32`: its exponent and top two mantissa bits,
+/// four classes per factor of two.
+fn size_class(x: f32) -> usize {
+    (x.to_bits() >> 21) as usize
 }
 
 /// Half the surface area, in `f32` (the same formula the builder uses).
@@ -218,19 +222,22 @@ impl<S: Scalar> Tree<'_, S> {
     }
 
     /// The smallest area bucket such that about `wanted` non-root nodes are at least as large.
-    fn candidate_threshold(&self, histogram: &mut [u32; 256], wanted: usize) -> usize {
-        *histogram = [0; 256];
+    /// Buckets count size classes (quarter octaves) below the root's area (no node is
+    /// larger); the last one holds everything smaller still.
+    fn candidate_threshold(&self, histogram: &mut Histogram, wanted: usize) -> usize {
+        *histogram = [0; BUCKETS];
+        let top = size_class(half_area(&self.node(0).bounds()));
         for node in self.nodes.iter().skip(FIRST_PAIR) {
-            let bucket = exponent(half_area(&node.bounds()));
-            if let Some(h) = histogram.get_mut(bucket) {
+            let below = top.saturating_sub(size_class(half_area(&node.bounds())));
+            if let Some(h) = histogram.get_mut(below.min(BUCKETS - 1)) {
                 *h += 1;
             }
         }
         let mut total = 0usize;
-        for bucket in (0..256).rev() {
-            total += histogram.get(bucket).copied().unwrap_or(0) as usize;
+        for (below, &count) in histogram.iter().enumerate() {
+            total += count as usize;
             if total >= wanted {
-                return bucket + 1;
+                return top.saturating_sub(below);
             }
         }
         0
