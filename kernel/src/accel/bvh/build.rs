@@ -41,9 +41,7 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
     Ok((used, deepest))
 }
 
-/// The top-down build into `nodes`/`ids`, bounds unpadded. Not inlined, so that its frame (bins,
-/// pending stack) is gone before reinsertion runs: the M0 has little stack.
-#[inline(never)]
+/// The top-down build into `nodes`/`ids`, bounds unpadded.
 fn split_top_down<S: Scalar, P: Primitive<S>>(
     prims: &[P],
     nodes: &mut [Node<S>],

@@ -8,9 +8,9 @@
 //! area, and moves it there if that lowers the tree's cost. Leaves never change, so the cost
 //! to lower is the summed surface area of the inner nodes.
 //!
-//! Candidates are the nodes with the largest boxes (by quarter-octave size class), in rounds: a probe round over the largest
-//! 1% (at least 64 nodes), then up to three over the largest 10%, stopping as soon as a round
-//! lowers the cost by less than 0.2%. Trees a top-down build already got right (closed
+//! Candidates are the nodes with the largest boxes (by quarter-octave size class), in rounds:
+//! a probe round over the largest 1% (at least 64 nodes), then up to three over the largest
+//! 10%, stopping as soon as a round lowers the cost by less than 0.2%. Trees a top-down build already got right (closed
 //! meshes such as the bunny) stop after the probe.
 //!
 //! Everything happens in place in the caller's arena. Sibling pairs keep their layout: the
@@ -48,6 +48,10 @@ const NO_PARENT: u32 = u32::MAX;
 /// lays it out again as the builder does: pairs in depth-first order after their parent,
 /// leaves tiling `ids` in that order. Returns the new depth of the deepest leaf, or `None` if
 /// the tree is unchanged (nothing to gain, or too little scratch: see the module docs).
+///
+/// Not inlined: its stack (about 1 KB: the search stack, the size histogram) is used only when
+/// the pass runs.
+#[inline(never)]
 pub(super) fn reinsert<S: Scalar>(
     nodes: &mut [Node<S>],
     used: usize,
@@ -419,11 +423,13 @@ impl<S: Scalar> Tree<'_, S> {
     fn best_place(&self, b: &Aabb<S>, h: u32) -> Option<(usize, f32)> {
         let own = half_area(b);
         let mut best: Option<(usize, f32)> = None;
-        let mut stack = [(0u32, 0.0f32, 0u32); MAX_DEPTH + 2];
+        // (slot, induced cost): 8 bytes an entry, as the M0's stack is small; a place's depth
+        // is counted along its parent links only when it would become the best.
+        let mut stack = [(0u32, 0.0f32); MAX_DEPTH + 2];
         let mut sp = 1usize;
         while sp > 0 {
             sp -= 1;
-            let Some(&(x, induced, depth)) = stack.get(sp) else {
+            let Some(&(x, induced)) = stack.get(sp) else {
                 break;
             };
             let bound = induced + own;
@@ -434,8 +440,9 @@ impl<S: Scalar> Tree<'_, S> {
             let node = self.node(x);
             let merged = half_area(&node.bounds().union(b));
             let cost = induced + merged;
-            let fits = depth as usize + 1 + self.height(x).max(h) as usize <= MAX_DEPTH;
-            if fits && best.is_none_or(|(_, c)| cost < c) {
+            if best.is_none_or(|(_, c)| cost < c)
+                && self.depth(x) + 1 + self.height(x).max(h) as usize <= MAX_DEPTH
+            {
                 best = Some((x, cost));
             }
             if node.count != 0 {
@@ -458,12 +465,25 @@ impl<S: Scalar> Tree<'_, S> {
             };
             for child in order {
                 if let Some(entry) = stack.get_mut(sp) {
-                    *entry = (child as u32, child_induced, depth + 1);
+                    *entry = (child as u32, child_induced);
                     sp += 1;
                 }
             }
         }
         best
+    }
+
+    /// Depth of `slot` (the root is 0), counted along parent links; at most [`MAX_DEPTH`]
+    /// steps are taken.
+    fn depth(&self, slot: usize) -> usize {
+        let mut at = slot;
+        for d in 0..=MAX_DEPTH {
+            match self.parent(at) {
+                Some(p) => at = p,
+                None => return d,
+            }
+        }
+        MAX_DEPTH + 1
     }
 }
 
@@ -472,16 +492,6 @@ mod tests {
     use super::*;
     use crate::accel::bvh::{build::build, BuildOptions, BuilderKind};
     use crate::geom::Triangle;
-
-    /// Depth of `slot`, following parent links.
-    fn depth_of<S: Scalar>(t: &Tree<'_, S>, slot: usize) -> usize {
-        let (mut d, mut at) = (0, slot);
-        while let Some(p) = t.parent(at) {
-            d += 1;
-            at = p;
-        }
-        d
-    }
 
     /// A tree whose deepest leaf sits far down a chain (triangles at exponentially shrinking
     /// offsets, split at the midpoint). The cheapest place for that leaf's box is down there;
@@ -520,16 +530,16 @@ mod tests {
         t.link();
         let deepest = (0..used)
             .filter(|&s| s != 1 && t.node(s).count > 0)
-            .max_by_key(|&s| depth_of(&t, s))
+            .max_by_key(|&s| t.depth(s))
             .unwrap();
-        assert_eq!(depth_of(&t, deepest) as u32, depth);
+        assert_eq!(t.depth(deepest) as u32, depth);
         let tiny = t.node(deepest).bounds();
         // Unconstrained, some place near that leaf wins; a subtree of height `h` there would
         // put leaves at MAX_DEPTH + 1.
         let (free, _) = t.best_place(&tiny, 0).unwrap();
-        let h = (MAX_DEPTH - depth_of(&t, free)) as u32;
+        let h = (MAX_DEPTH - t.depth(free)) as u32;
         let (x, _) = t.best_place(&tiny, h).unwrap();
-        let dx = depth_of(&t, x);
+        let dx = t.depth(x);
         assert!(
             dx + 1 + t.height(x).max(h) as usize <= MAX_DEPTH,
             "placed at depth {dx}, height {} with a subtree of height {h}",
