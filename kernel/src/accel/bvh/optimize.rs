@@ -9,7 +9,7 @@
 //! to lower is the summed surface area of the inner nodes.
 //!
 //! Candidates are the nodes with the largest boxes (by quarter-octave size class), in rounds:
-//! a probe round over the largest 1% (at least 64 nodes), then up to three over the largest
+//! a probe round over the largest 0.25% (at least 64 nodes), then up to three over the largest
 //! 10%, stopping as soon as a round lowers the cost by less than 0.2%. Trees a top-down build already got right (closed
 //! meshes such as the bunny) stop after the probe.
 //!
@@ -30,7 +30,7 @@ use crate::scalar::Scalar;
 
 /// Share of the nodes (largest boxes first, as `1 / n`) that each round tries to move. The
 /// first round is a cheap probe: a tree it cannot improve gets no further rounds.
-const ROUND_SHARES: [usize; 4] = [100, 10, 10, 10];
+const ROUND_SHARES: [usize; 4] = [400, 10, 10, 10];
 /// Fewest candidates a round considers (all nodes of small trees).
 const MIN_CANDIDATES: usize = 64;
 /// Rounds stop once one lowers the cost by less than this fraction.
