@@ -2,7 +2,7 @@
 //! nodes replaces recursion. Split decisions use `f32` keys (centroids, areas) in both modes;
 //! `f32` arithmetic is deterministic, so fixed-point trees are identical on every platform too.
 
-use super::select::{partition, select_nth, swap_in};
+use super::select::{select_nth, swap_in};
 use super::{
     nodes_needed, BuildOptions, BuilderKind, Node, FIRST_PAIR, MAX_DEPTH, MAX_LEAF_SIZE,
     MEDIAN_FALLBACK_DEPTH,
@@ -403,27 +403,18 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         side
     }
 
-    /// As [`Builder::summarize`], adding the boxes last to first.
-    fn summarize_rev<T: Slot<S>>(&self, ids: &[T]) -> Side<S> {
-        let mut side = Side::empty();
-        for id in ids.iter().rev() {
-            side.add(&id.bounds(self.prims));
-        }
-        side
-    }
-
     /// Partitions `ids` by `left`, summarizing both sides on the way.
     fn partition_by<T: Slot<S>>(
         &self,
         ids: &mut [T],
-        left: impl Fn(&Aabb<S>) -> bool,
+        left: impl Fn(&T, &Aabb<S>) -> bool,
     ) -> [Side<S>; 2] {
         let mut sides = [Side::empty(), Side::empty()];
         let (mut i, mut j) = (0, ids.len());
         while i < j {
             let Some(id) = ids.get(i) else { break };
             let b = id.bounds(self.prims);
-            if left(&b) {
+            if left(id, &b) {
                 sides[0].add(&b);
                 i += 1;
             } else {
@@ -464,7 +455,7 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
             BuilderKind::Median => must_split.then(|| self.median(ids, widest)),
             BuilderKind::Midpoint => must_split.then(|| {
                 let mid = clo[widest] * 0.5 + chi[widest] * 0.5;
-                let sides = self.partition_by(ids, |b| key(b, widest) < mid);
+                let sides = self.partition_by(ids, |_, b| key(b, widest) < mid);
                 if sides[0].count == 0 || sides[1].count == 0 {
                     self.median(ids, widest)
                 } else {
@@ -512,10 +503,13 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         for id in ids.iter_mut() {
             let b = id.bounds(self.prims);
             let (lo, hi) = (lanes(&b.lo), lanes(&b.hi));
-            let bin: [i32; 4] = core::array::from_fn(|k| {
-                let c = lo[k].to_f32() * 0.5 + hi[k].to_f32() * 0.5;
-                bin_index((c - origin[k]) * scale4[k], top)
-            });
+            let bin = bin_lanes(
+                core::array::from_fn(|k| {
+                    let c = lo[k].to_f32() * 0.5 + hi[k].to_f32() * 0.5;
+                    (c - origin[k]) * scale4[k]
+                }),
+                top,
+            );
             // Each bin is below `nb <= 32`: five bits per axis.
             id.set_tag((bin[0] | bin[1] << 5 | bin[2] << 10) as u32);
             for ((boxes, counts), bin) in bins.boxes.iter_mut().zip(bins.counts.iter_mut()).zip(bin)
@@ -534,28 +528,31 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         }
         let axis = axis.min(2); // a no-op that shows the compiler the bound
         let (shift, origin, scale) = (5 * axis, clo[axis], scale[axis]);
-        let left = partition(ids, |id| {
+        Some(self.partition_by(ids, |id, b| {
             let bin = if T::TAGGED {
                 (id.tag() >> shift) as usize & 31
             } else {
-                bin_index((key(&id.bounds(self.prims), axis) - origin) * scale, top) as usize
+                bin_lanes([(key(b, axis) - origin) * scale; 4], top)[0] as usize
             };
             bin <= last_left_bin
-        });
-        // `partition_by`'s order of adding boxes: the left side first to last, the right side
-        // last to first (where each was swapped to).
-        let (l, r) = ids.split_at(left);
-        Some([self.summarize(l), self.summarize_rev(r)])
+        }))
     }
 }
 
-/// The bin of a scaled centroid offset `f`: `(f as i32).clamp(0, top)` (for a whole `top >= 0`),
-/// clamped as a float so that the final cast never saturates.
+/// The bins of four scaled centroid offsets: per lane `(f as i32).clamp(0, top)` (a saturating
+/// cast, NaN to 0, then clamped; `top` is a whole number below 32), computed with float
+/// operations only so that all four lanes go through the same vector instructions.
 #[inline(always)]
-fn bin_index(f: f32, top: f32) -> i32 {
-    let f = if f > 0.0 { f } else { 0.0 }; // negative and NaN: 0
-    let f = if f < top { f } else { top };
-    f as i32
+fn bin_lanes(f: [f32; 4], top: f32) -> [u32; 4] {
+    // 1.5 * 2^23: adding it to a number in [0, 2^22] rounds that to a whole number.
+    const MAGIC: f32 = 12_582_912.0;
+    core::array::from_fn(|k| {
+        let x = if f[k] > 0.0 { f[k] } else { 0.0 }; // negative and NaN: 0
+        let x = if x < top { x } else { top }; // then x as i32 == (f as i32).clamp(0, top)
+        let rounded = x + MAGIC; // x rounded to a whole number, plus MAGIC
+                                 // Truncated: one less if rounded up (an integer subtraction: no select to branch on).
+        (rounded.to_bits() - MAGIC.to_bits()) - u32::from(rounded - MAGIC > x)
+    })
 }
 
 /// Best SAH split over the bins (filled by [`Builder::sah`]): (cost, axis, last bin of the
@@ -628,4 +625,63 @@ fn sweep<S: Scalar>(
         }
     }
     best.map(|(cost, axis, bin)| (cost, axis, bin, parent_area))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::bin_lanes;
+
+    /// The bin of `f` as the builder first computed it.
+    fn bin_reference(f: f32, top: i32) -> u32 {
+        (f as i32).clamp(0, top) as u32
+    }
+
+    #[test]
+    fn bin_lanes_is_the_saturating_cast_clamped() {
+        let special = [
+            f32::NAN,
+            -f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            0.0,
+            -0.0,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            f32::from_bits(1),
+            f32::MAX,
+            f32::MIN,
+            2_147_483_648.0,
+            -2_147_483_904.0,
+            12_582_912.0,
+            4_194_304.5,
+        ];
+        let near_whole = (0..=40).flat_map(|i| {
+            let x = i as f32;
+            let (up, down) = (f32::from_bits(x.to_bits() + 1), x - x * f32::EPSILON);
+            [x, -x, x - 0.5, x + 0.5, up, down, -up, x - 1e-7, x + 1e-7]
+        });
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let random = core::iter::repeat_with(move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            f32::from_bits((seed >> 32) as u32)
+        })
+        .take(100_000);
+        let small = (0..20_000).map(|i| i as f32 * 0.0017 - 3.0);
+        for f in special
+            .into_iter()
+            .chain(near_whole)
+            .chain(random)
+            .chain(small)
+        {
+            for top in 3..32 {
+                let want = bin_reference(f, top);
+                let got = bin_lanes([f, 0.0, f, -f], top as f32);
+                assert_eq!(got[0], want, "f = {f:e} ({:#x}), top = {top}", f.to_bits());
+                assert_eq!(got[2], want, "f = {f:e}, top = {top}");
+                assert_eq!(got[3], bin_reference(-f, top), "f = {:e}, top = {top}", -f);
+            }
+        }
+    }
 }
