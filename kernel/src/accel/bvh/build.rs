@@ -112,7 +112,21 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
         centroids: root.centroids(),
     }; MAX_DEPTH + 2];
     let mut sp = 1usize;
-    let mut bins = Bins::<S>::new();
+    // Zeroed (in place), then emptied bin by bin: an array of `Bin::empty()` was built in a
+    // temporary and copied, 3.5 KB more stack on the M0.
+    let zero = Bin {
+        lo: [S::ZERO; 4],
+        hi: [S::ZERO; 4],
+    };
+    let mut boxes = [[zero; BINS]; 3];
+    for bin in boxes.iter_mut().flatten() {
+        *bin = Bin::empty();
+    }
+    let mut counts = [[0u32; BINS]; 3];
+    let mut bins = Bins {
+        boxes: &mut boxes,
+        counts: &mut counts,
+    };
     while sp > 0 {
         sp -= 1;
         let Some(&Pending {
@@ -229,18 +243,9 @@ impl<S: Scalar> Bin<S> {
 
 /// SAH bins per axis: boxes and primitive counts. Every bin is empty between splits:
 /// [`Builder::sah`] fills bins, [`sweep`] empties the ones it filled.
-struct Bins<S> {
-    boxes: [[Bin<S>; BINS]; 3],
-    counts: [[u32; BINS]; 3],
-}
-
-impl<S: Scalar> Bins<S> {
-    fn new() -> Self {
-        Self {
-            boxes: [[Bin::empty(); BINS]; 3],
-            counts: [[0; BINS]; 3],
-        }
-    }
+struct Bins<'a, S> {
+    boxes: &'a mut [[Bin<S>; BINS]; 3],
+    counts: &'a mut [[u32; BINS]; 3],
 }
 
 /// A corner as four lanes, lane 3 repeating lane 2.
@@ -432,7 +437,7 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         ids: &mut [T],
         depth: usize,
         centroids: &Centroids,
-        bins: &mut Bins<S>,
+        bins: &mut Bins<'_, S>,
     ) -> Option<[Side<S>; 2]> {
         let count = ids.len();
         if count <= 1 {
@@ -484,7 +489,7 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         ids: &mut [T],
         clo: &[f32; 3],
         extent: &[f32; 3],
-        bins: &mut Bins<S>,
+        bins: &mut Bins<'_, S>,
     ) -> Option<[Side<S>; 2]> {
         let count = ids.len();
         // Small nodes use fewer bins: the same choices for less set-up work.
@@ -593,7 +598,7 @@ fn bin_lanes(f: [f32; 4], top: f32) -> [u32; 4] {
 /// keep the first), just as in a sweep over every bin.
 #[inline(never)]
 fn sweep<S: Scalar>(
-    bins: &mut Bins<S>,
+    bins: &mut Bins<'_, S>,
     nb: usize,
     scale: &[f32; 3],
 ) -> Option<(f32, usize, usize, f32)> {
