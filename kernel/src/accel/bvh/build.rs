@@ -122,11 +122,11 @@ fn split_top_down<S: Scalar, P: Primitive<S>>(
     let mut used = 1usize;
     match nodes {
         [root_slot, pad, ..] if n > 1 => {
-            *root_slot = Node::leaf(root.bounds, 0, n as u32);
+            *root_slot = Node::leaf(root.bounds(), 0, n as u32);
             *pad = Node::EMPTY;
             used = FIRST_PAIR;
         }
-        [root_slot, ..] => *root_slot = Node::leaf(root.bounds, 0, n as u32),
+        [root_slot, ..] => *root_slot = Node::leaf(root.bounds(), 0, n as u32),
         [] => return Ok((0, 0)),
     }
     let mut deepest = 0u32;
@@ -134,10 +134,24 @@ fn split_top_down<S: Scalar, P: Primitive<S>>(
     let mut stack = [Pending {
         index: 0,
         depth: 0,
-        centroids: root.centroids,
+        centroids: root.centroids(),
     }; MAX_DEPTH + 2];
     let mut sp = 1usize;
-    let mut bins = [[(empty_box::<S>(), 0u32); BINS]; 3];
+    // Zeroed (in place), then emptied bin by bin: an array of `Bin::empty()` was built in a
+    // temporary and copied, 3.5 KB more stack on the M0.
+    let zero = Bin {
+        lo: [S::ZERO; 4],
+        hi: [S::ZERO; 4],
+    };
+    let mut boxes = [[zero; BINS]; 3];
+    for bin in boxes.iter_mut().flatten() {
+        *bin = Bin::empty();
+    }
+    let mut counts = [[0u32; BINS]; 3];
+    let mut bins = Bins {
+        boxes: &mut boxes,
+        counts: &mut counts,
+    };
     while sp > 0 {
         sp -= 1;
         let Some(&Pending {
@@ -184,9 +198,9 @@ fn split_top_down<S: Scalar, P: Primitive<S>>(
         let Some([a, b]) = nodes.get_mut(l..l + 2) else {
             continue;
         };
-        *a = Node::leaf(left.bounds, first as u32, left.count as u32);
+        *a = Node::leaf(left.bounds(), first as u32, left.count as u32);
         *b = Node::leaf(
-            right.bounds,
+            right.bounds(),
             (first + left.count) as u32,
             right.count as u32,
         );
@@ -204,7 +218,7 @@ fn split_top_down<S: Scalar, P: Primitive<S>>(
                 *slot = Pending {
                     index: child as u32,
                     depth: depth + 1,
-                    centroids: side.centroids,
+                    centroids: side.centroids(),
                 };
                 sp += 1;
             }
@@ -213,8 +227,52 @@ fn split_top_down<S: Scalar, P: Primitive<S>>(
     Ok((used, deepest))
 }
 
-/// SAH bins per axis: box and primitive count.
-type Bins<S> = [[(Aabb<S>, u32); BINS]; 3];
+/// One SAH bin's box, as four lanes per corner (lane 3 repeats lane 2) so that a union is
+/// two vector min/max operations.
+#[derive(Clone, Copy)]
+struct Bin<S> {
+    lo: [S; 4],
+    hi: [S; 4],
+}
+
+impl<S: Scalar> Bin<S> {
+    /// The empty bin: any union replaces it.
+    fn empty() -> Self {
+        Self {
+            lo: [S::FAR; 4],
+            hi: [lowest::<S>(); 4],
+        }
+    }
+
+    /// Grows the bin to hold the box with corners `lo`, `hi` (four lanes each).
+    #[inline(always)]
+    fn grow(&mut self, lo: &[S; 4], hi: &[S; 4]) {
+        for k in 0..4 {
+            self.lo[k] = self.lo[k].min_of(lo[k]);
+            self.hi[k] = self.hi[k].max_of(hi[k]);
+        }
+    }
+
+    /// Half the surface area, in `f32`.
+    #[inline(always)]
+    fn half_area(&self) -> f32 {
+        let d: [f32; 3] = core::array::from_fn(|i| self.hi[i].to_f32() - self.lo[i].to_f32());
+        d[0] * d[1] + d[1] * d[2] + d[2] * d[0]
+    }
+}
+
+/// SAH bins per axis: boxes and primitive counts. Every bin is empty between splits:
+/// [`Builder::sah`] fills bins, [`sweep`] empties the ones it filled.
+struct Bins<'a, S> {
+    boxes: &'a mut [[Bin<S>; BINS]; 3],
+    counts: &'a mut [[u32; BINS]; 3],
+}
+
+/// A corner as four lanes, lane 3 repeating lane 2.
+#[inline(always)]
+fn lanes<S: Scalar>(v: &[S; 3]) -> [S; 4] {
+    [v[0], v[1], v[2], v[2]]
+}
 
 /// A node waiting to be split.
 #[derive(Clone, Copy)]
@@ -227,31 +285,47 @@ struct Pending {
 /// Per-axis (min, max) of the centroid keys of a set of primitives.
 type Centroids = ([f32; 3], [f32; 3]);
 
-/// What a split search knows about one side: its size, box and centroid bounds.
+/// What a split search knows about one side: its size, box and centroid bounds (as four
+/// lanes, lane 3 repeating lane 2).
 #[derive(Clone, Copy)]
 struct Side<S: Scalar> {
     count: usize,
-    bounds: Aabb<S>,
-    centroids: Centroids,
+    bin: Bin<S>,
+    centroid_lo: [f32; 4],
+    centroid_hi: [f32; 4],
 }
 
 impl<S: Scalar> Side<S> {
     fn empty() -> Self {
         Self {
             count: 0,
-            bounds: empty_box(),
-            centroids: ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+            bin: Bin::empty(),
+            centroid_lo: [f32::INFINITY; 4],
+            centroid_hi: [f32::NEG_INFINITY; 4],
         }
     }
 
+    /// Adds a box: a union, and the min/max of its [`key`]s, in lanes.
+    #[inline(always)]
     fn add(&mut self, b: &Aabb<S>) {
         self.count += 1;
-        self.bounds = self.bounds.union(b);
-        for axis in 0..3 {
-            let c = key(b, axis);
-            self.centroids.0[axis] = self.centroids.0[axis].min_of(c);
-            self.centroids.1[axis] = self.centroids.1[axis].max_of(c);
+        let (lo, hi) = (lanes(&b.lo), lanes(&b.hi));
+        self.bin.grow(&lo, &hi);
+        for k in 0..4 {
+            let c = lo[k].to_f32() * 0.5 + hi[k].to_f32() * 0.5;
+            self.centroid_lo[k] = self.centroid_lo[k].min_of(c);
+            self.centroid_hi[k] = self.centroid_hi[k].max_of(c);
         }
+    }
+
+    fn bounds(&self) -> Aabb<S> {
+        let (lo, hi) = (&self.bin.lo, &self.bin.hi);
+        Aabb::new([lo[0], lo[1], lo[2]], [hi[0], hi[1], hi[2]])
+    }
+
+    fn centroids(&self) -> Centroids {
+        let (lo, hi) = (&self.centroid_lo, &self.centroid_hi);
+        ([lo[0], lo[1], lo[2]], [hi[0], hi[1], hi[2]])
     }
 }
 
@@ -271,12 +345,6 @@ fn key<S: Scalar>(b: &Aabb<S>, axis: usize) -> f32 {
     b.lo[axis].to_f32() * 0.5 + b.hi[axis].to_f32() * 0.5
 }
 
-/// Half the surface area, in `f32`.
-fn half_area<S: Scalar>(b: &Aabb<S>) -> f32 {
-    let d: [f32; 3] = core::array::from_fn(|i| b.hi[i].to_f32() - b.lo[i].to_f32());
-    d[0] * d[1] + d[1] * d[2] + d[2] * d[0]
-}
-
 /// A box that any union replaces: `lo = FAR`, `hi = lowest`.
 fn empty_box<S: Scalar>() -> Aabb<S> {
     Aabb::new([S::FAR; 3], [lowest::<S>(); 3])
@@ -293,6 +361,12 @@ trait Slot<S: Scalar>: Copy {
     fn id(&self) -> u32;
     /// The primitive's box, from the cache or recomputed.
     fn bounds<P: Primitive<S>>(&self, prims: &[P]) -> Aabb<S>;
+    /// True if the slot keeps a tag (the SAH bins of its primitive).
+    const TAGGED: bool;
+    /// The tag last set (0 if the slot keeps none).
+    fn tag(&self) -> u32;
+    /// Sets the tag (a no-op if the slot keeps none).
+    fn set_tag(&mut self, tag: u32);
 }
 
 impl<S: Scalar> Slot<S> for u32 {
@@ -307,6 +381,13 @@ impl<S: Scalar> Slot<S> for u32 {
             None => empty_box(),
         }
     }
+    const TAGGED: bool = false;
+    #[inline(always)]
+    fn tag(&self) -> u32 {
+        0
+    }
+    #[inline(always)]
+    fn set_tag(&mut self, _tag: u32) {}
 }
 
 impl<S: Scalar> Slot<S> for Node<S> {
@@ -317,6 +398,16 @@ impl<S: Scalar> Slot<S> for Node<S> {
     #[inline(always)]
     fn bounds<P: Primitive<S>>(&self, _prims: &[P]) -> Aabb<S> {
         Aabb::new(self.lo, self.hi)
+    }
+    // A cache slot's `count` is otherwise unused.
+    const TAGGED: bool = true;
+    #[inline(always)]
+    fn tag(&self) -> u32 {
+        self.count
+    }
+    #[inline(always)]
+    fn set_tag(&mut self, tag: u32) {
+        self.count = tag;
     }
 }
 
@@ -341,14 +432,14 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
     fn partition_by<T: Slot<S>>(
         &self,
         ids: &mut [T],
-        left: impl Fn(&Aabb<S>) -> bool,
+        left: impl Fn(&T, &Aabb<S>) -> bool,
     ) -> [Side<S>; 2] {
         let mut sides = [Side::empty(), Side::empty()];
         let (mut i, mut j) = (0, ids.len());
         while i < j {
             let Some(id) = ids.get(i) else { break };
             let b = id.bounds(self.prims);
-            if left(&b) {
+            if left(id, &b) {
                 sides[0].add(&b);
                 i += 1;
             } else {
@@ -366,7 +457,7 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         ids: &mut [T],
         depth: usize,
         centroids: &Centroids,
-        bins: &mut Bins<S>,
+        bins: &mut Bins<'_, S>,
     ) -> Option<[Side<S>; 2]> {
         let count = ids.len();
         if count <= 1 {
@@ -389,7 +480,7 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
             BuilderKind::Median => must_split.then(|| self.median(ids, widest)),
             BuilderKind::Midpoint => must_split.then(|| {
                 let mid = clo[widest] * 0.5 + chi[widest] * 0.5;
-                let sides = self.partition_by(ids, |b| key(b, widest) < mid);
+                let sides = self.partition_by(ids, |_, b| key(b, widest) < mid);
                 if sides[0].count == 0 || sides[1].count == 0 {
                     self.median(ids, widest)
                 } else {
@@ -418,16 +509,11 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         ids: &mut [T],
         clo: &[f32; 3],
         extent: &[f32; 3],
-        bins: &mut Bins<S>,
+        bins: &mut Bins<'_, S>,
     ) -> Option<[Side<S>; 2]> {
         let count = ids.len();
         // Small nodes use fewer bins: the same choices for less set-up work.
         let nb = count.clamp(4, BINS);
-        for axis_bins in bins.iter_mut() {
-            for bin in axis_bins.iter_mut().take(nb) {
-                *bin = (empty_box(), 0);
-            }
-        }
         let scale: [f32; 3] = core::array::from_fn(|a| {
             let s = nb as f32 / extent[a];
             if extent[a] > 0.0 && s.is_finite() {
@@ -436,60 +522,221 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
                 0.0
             }
         });
-        let bin_of = |c: f32, a: usize| -> usize {
-            // Saturating cast (NaN -> 0), then clamped: always a valid bin.
-            let b = ((c - clo[a]) * scale[a]) as i32;
-            b.clamp(0, nb as i32 - 1) as usize
-        };
-        for id in ids.iter() {
+        if let [p, q] = ids {
+            let pair = [p.bounds(self.prims), q.bounds(self.prims)];
+            let axis = self.sah_pair(pair, &scale)?.min(2); // `min`: shows the bound
+            return Some(self.partition_by(ids, |_, b| key(b, axis) <= clo[axis]));
+        }
+        // Bin each primitive on all three axes, remembering its bins in the slot's tag (when it
+        // keeps one) for the partition below.
+        let (origin, scale4, top) = (lanes(clo), lanes(&scale), (nb - 1) as f32);
+        for id in ids.iter_mut() {
             let b = id.bounds(self.prims);
-            for (a, axis_bins) in bins.iter_mut().enumerate() {
+            let (lo, hi) = (lanes(&b.lo), lanes(&b.hi));
+            let bin = bin_lanes(
+                core::array::from_fn(|k| {
+                    let c = lo[k].to_f32() * 0.5 + hi[k].to_f32() * 0.5;
+                    (c - origin[k]) * scale4[k]
+                }),
+                top,
+            );
+            // Each bin is below `nb <= 32`: five bits per axis.
+            id.set_tag((bin[0] | bin[1] << 5 | bin[2] << 10) as u32);
+            for ((boxes, counts), bin) in bins.boxes.iter_mut().zip(bins.counts.iter_mut()).zip(bin)
+            {
                 // `% BINS` is a no-op (bins < nb <= BINS) that shows the compiler the bound.
-                let bin = &mut axis_bins[bin_of(key(&b, a), a) % BINS];
-                bin.0 = bin.0.union(&b);
-                bin.1 += 1;
+                let bin = bin as usize % BINS;
+                boxes[bin].grow(&lo, &hi);
+                counts[bin] += 1;
             }
         }
-        // Sweep each axis: cost(split after bin i) = A_left·N_left + A_right·N_right.
-        let mut best: Option<(f32, usize, usize, Aabb<S>)> = None;
-        for a in 0..3 {
-            if scale[a] == 0.0 {
-                continue;
-            }
-            let axis_bins = bins[a].get(..nb).unwrap_or_default();
-            let mut right_cost = [0.0f32; BINS];
-            let mut right = (empty_box::<S>(), 0u32);
-            for (bin, rc) in axis_bins.iter().zip(right_cost.iter_mut()).skip(1).rev() {
-                right.0 = right.0.union(&bin.0);
-                right.1 += bin.1;
-                *rc = if right.1 > 0 {
-                    half_area(&right.0) * right.1 as f32
-                } else {
-                    0.0
-                };
-            }
-            let mut left = (empty_box::<S>(), 0u32);
-            let sweep = axis_bins.iter().zip(right_cost.iter().skip(1));
-            for (i, (bin, rc)) in sweep.take(nb - 1).enumerate() {
-                left.0 = left.0.union(&bin.0);
-                left.1 += bin.1;
-                if left.1 == 0 || left.1 as usize == count {
-                    continue;
-                }
-                let cost = half_area(&left.0) * left.1 as f32 + rc;
-                if best.is_none_or(|b| cost < b.0) {
-                    best = Some((cost, a, i, left.0.union(&right.0)));
-                }
-            }
-        }
-        let (cost, axis, last_left_bin, parent) = best?;
-        let axis = axis.min(2); // a no-op that shows the compiler the bound
-        let parent_area = half_area(&parent);
+        let (cost, axis, last_left_bin, parent_area) = sweep(bins, nb, &scale)?;
         if count <= self.max_leaf
             && parent_area * count as f32 <= TRAVERSAL_COST * parent_area + cost
         {
             return None;
         }
-        Some(self.partition_by(ids, |b| bin_of(key(b, axis), axis) <= last_left_bin))
+        let axis = axis.min(2); // a no-op that shows the compiler the bound
+        let (shift, origin, scale) = (5 * axis, clo[axis], scale[axis]);
+        Some(self.partition_by(ids, |id, b| {
+            let bin = if T::TAGGED {
+                (id.tag() >> shift) as usize & 31
+            } else {
+                bin_lanes([(key(b, axis) - origin) * scale; 4], top)[0] as usize
+            };
+            bin <= last_left_bin
+        }))
+    }
+}
+
+impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
+    /// [`Builder::sah`] for two primitives with boxes `p`, `q`: the axis to split on, or `None`
+    /// for a leaf (or no axis separating the centroids).
+    ///
+    /// The binned sweep reduces to this: on an axis that separates the two centroids, the lower
+    /// one is the minimum (bin 0) and the upper one lies `extent` above it, which scales to
+    /// within a few ulps of 4 (bin `nb - 1 = 3`). So each such axis has one candidate,
+    /// `{lower} | {upper}`, of cost `half_area(p)·1 + half_area(q)·1` in either order, and the
+    /// first such axis wins the tie. The parent's area is that of the union.
+    fn sah_pair(&self, [p, q]: [Aabb<S>; 2], scale: &[f32; 3]) -> Option<usize> {
+        let axis = (0..3).find(|&a| scale[a] != 0.0)?;
+        let (mut p_bin, mut q_bin) = (Bin::<S>::empty(), Bin::<S>::empty());
+        p_bin.grow(&lanes(&p.lo), &lanes(&p.hi));
+        q_bin.grow(&lanes(&q.lo), &lanes(&q.hi));
+        let cost = p_bin.half_area() * 1.0 + q_bin.half_area() * 1.0;
+        let mut parent = p_bin;
+        parent.grow(&q_bin.lo, &q_bin.hi);
+        let parent_area = parent.half_area();
+        if 2 <= self.max_leaf && parent_area * 2.0 <= TRAVERSAL_COST * parent_area + cost {
+            return None;
+        }
+        Some(axis)
+    }
+}
+
+/// The bins of four scaled centroid offsets: per lane `(f as i32).clamp(0, top)` (a saturating
+/// cast, NaN to 0, then clamped; `top` is a whole number below 32), computed with float
+/// operations only so that all four lanes go through the same vector instructions.
+#[inline(always)]
+fn bin_lanes(f: [f32; 4], top: f32) -> [u32; 4] {
+    // 1.5 * 2^23: adding it to a number in [0, 2^22] rounds that to a whole number.
+    const MAGIC: f32 = 12_582_912.0;
+    core::array::from_fn(|k| {
+        let x = if f[k] > 0.0 { f[k] } else { 0.0 }; // negative and NaN: 0
+        let x = if x < top { x } else { top }; // then x as i32 == (f as i32).clamp(0, top)
+        let rounded = x + MAGIC; // x rounded to a whole number, plus MAGIC
+                                 // Truncated: one less if rounded up (an integer subtraction: no select to branch on).
+        (rounded.to_bits() - MAGIC.to_bits()) - u32::from(rounded - MAGIC > x)
+    })
+}
+
+/// Best SAH split over the bins (filled by [`Builder::sah`]): (cost, axis, last bin of the
+/// left side, half area of the parent). Leaves every bin empty again.
+///
+/// Only occupied bins are visited: at an empty bin the left side's box and count and the right
+/// side's cost are those of the occupied bin before it, so its cost ties and never wins (ties
+/// keep the first), just as in a sweep over every bin.
+#[inline(never)]
+fn sweep<S: Scalar>(
+    bins: &mut Bins<'_, S>,
+    nb: usize,
+    scale: &[f32; 3],
+) -> Option<(f32, usize, usize, f32)> {
+    let mut best: Option<(f32, usize, usize)> = None;
+    let mut parent_area = 0.0;
+    // Written (right to left) at each occupied bin but the first before it is read.
+    let mut right_cost = [0.0f32; BINS];
+    for (a, (boxes, counts)) in bins
+        .boxes
+        .iter_mut()
+        .zip(bins.counts.iter_mut())
+        .enumerate()
+    {
+        let mut occupied = 0u32;
+        for (k, &n) in counts.iter().enumerate().take(nb) {
+            occupied |= u32::from(n != 0) << k;
+        }
+        if scale[a] != 0.0 {
+            // Right to left: cost of the right side starting at each occupied bin but the
+            // first.
+            let (mut right, mut right_count) = (Bin::<S>::empty(), 0u32);
+            let mut rest = occupied & !1;
+            while rest != 0 {
+                let k = (31 - rest.leading_zeros()) as usize % BINS;
+                rest &= !(1 << k);
+                right.grow(&boxes[k].lo, &boxes[k].hi);
+                right_count += counts[k];
+                right_cost[k] = right.half_area() * right_count as f32;
+            }
+            // Left to right: split after each occupied bin but the last (whose left side holds
+            // everything); the right side starts at the next occupied bin.
+            let (mut left, mut left_count) = (Bin::<S>::empty(), 0u32);
+            let mut rest = occupied;
+            while rest != 0 {
+                let i = rest.trailing_zeros() as usize % BINS;
+                rest &= rest - 1;
+                left.grow(&boxes[i].lo, &boxes[i].hi);
+                left_count += counts[i];
+                if rest != 0 {
+                    let next = rest.trailing_zeros() as usize % BINS;
+                    let cost = left.half_area() * left_count as f32 + right_cost[next];
+                    if best.is_none_or(|b| cost < b.0) {
+                        best = Some((cost, a, i));
+                    }
+                }
+            }
+            // `left` now holds every bin: the parent's box, whose area (the order of a union's
+            // operands does not change it) goes with the best split found so far.
+            if best.is_some_and(|b| b.1 == a) {
+                parent_area = left.half_area();
+            }
+        }
+        let mut rest = occupied;
+        while rest != 0 {
+            let k = rest.trailing_zeros() as usize % BINS;
+            rest &= rest - 1;
+            boxes[k] = Bin::empty();
+            counts[k] = 0;
+        }
+    }
+    best.map(|(cost, axis, bin)| (cost, axis, bin, parent_area))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::bin_lanes;
+
+    /// The bin of `f` as the builder first computed it.
+    fn bin_reference(f: f32, top: i32) -> u32 {
+        (f as i32).clamp(0, top) as u32
+    }
+
+    #[test]
+    fn bin_lanes_is_the_saturating_cast_clamped() {
+        let special = [
+            f32::NAN,
+            -f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            0.0,
+            -0.0,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            f32::from_bits(1),
+            f32::MAX,
+            f32::MIN,
+            2_147_483_648.0,
+            -2_147_483_904.0,
+            12_582_912.0,
+            4_194_304.5,
+        ];
+        let near_whole = (0..=40).flat_map(|i| {
+            let x = i as f32;
+            let (up, down) = (f32::from_bits(x.to_bits() + 1), x - x * f32::EPSILON);
+            [x, -x, x - 0.5, x + 0.5, up, down, -up, x - 1e-7, x + 1e-7]
+        });
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let random = core::iter::repeat_with(move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            f32::from_bits((seed >> 32) as u32)
+        })
+        .take(100_000);
+        let small = (0..20_000).map(|i| i as f32 * 0.0017 - 3.0);
+        for f in special
+            .into_iter()
+            .chain(near_whole)
+            .chain(random)
+            .chain(small)
+        {
+            for top in 3..32 {
+                let want = bin_reference(f, top);
+                let got = bin_lanes([f, 0.0, f, -f], top as f32);
+                assert_eq!(got[0], want, "f = {f:e} ({:#x}), top = {top}", f.to_bits());
+                assert_eq!(got[2], want, "f = {f:e}, top = {top}");
+                assert_eq!(got[3], bin_reference(-f, top), "f = {:e}, top = {top}", -f);
+            }
+        }
     }
 }
