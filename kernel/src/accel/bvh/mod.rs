@@ -4,7 +4,9 @@
 //! with one slot per primitive. [`Bvh::build`] fills them (no allocation, no recursion) and
 //! returns a [`Bvh`] that borrows them. Three builders: binned SAH (default), median split
 //! (sort along an axis, split in the middle) and midpoint split (partition at the middle of an
-//! axis, median when that leaves a side empty).
+//! axis, median when that leaves a side empty). By default a reinsertion pass follows
+//! (`optimize.rs`, [`BuildOptions::reinsertion`]): it moves subtrees to where they lower the
+//! tree's SAH cost, never past the depth cap.
 //!
 //! Depth is capped at [`MAX_DEPTH`]: from depth 32 on, every builder splits at the median, which
 //! halves the count, so no tree is deeper than 32 + 32 levels. Traversal uses a stack of
