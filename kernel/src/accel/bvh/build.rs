@@ -256,8 +256,7 @@ impl<S: Scalar> Bin<S> {
     /// Half the surface area, in `f32`.
     #[inline(always)]
     fn half_area(&self) -> f32 {
-        let d: [f32; 3] = core::array::from_fn(|i| self.hi[i].to_f32() - self.lo[i].to_f32());
-        d[0] * d[1] + d[1] * d[2] + d[2] * d[0]
+        super::half_area(&self.lo, &self.hi)
     }
 }
 

@@ -47,6 +47,17 @@ pub const fn nodes_needed(prim_count: usize) -> usize {
     }
 }
 
+/// Half the surface area of the box with corners `lo`, `hi` (first three lanes), in `f32`:
+/// the SAH's measure for the builder's splits and the reinsertion pass's cost.
+#[inline(always)]
+pub(crate) fn half_area<S: Scalar>(lo: &[S], hi: &[S]) -> f32 {
+    let d: [f32; 3] = core::array::from_fn(|i| {
+        let (l, h) = (lo.get(i).copied(), hi.get(i).copied());
+        h.unwrap_or(S::ZERO).to_f32() - l.unwrap_or(S::ZERO).to_f32()
+    });
+    d[0] * d[1] + d[1] * d[2] + d[2] * d[0]
+}
+
 /// Index of the first child pair: slot 1 is padding so pairs sit at even slots.
 pub(crate) const FIRST_PAIR: usize = 2;
 

@@ -96,29 +96,8 @@ pub(super) fn reinsert<S: Scalar>(
 }
 
 /// Visits the tree in `nodes` depth first, left child first (the builder's order), calling
-/// `visit` with each slot and node. Explicit stack: one pending sibling per level.
-fn walk<S: Scalar>(nodes: &[Node<S>], mut visit: impl FnMut(usize, &Node<S>)) {
-    let mut stack = [0u32; MAX_DEPTH + 2];
-    let mut sp = 1usize;
-    while sp > 0 {
-        sp -= 1;
-        let Some(&x) = stack.get(sp) else { break };
-        let Some(node) = nodes.get(x as usize) else {
-            continue;
-        };
-        visit(x as usize, node);
-        if node.count == 0 {
-            for child in [node.first + 1, node.first] {
-                if let Some(entry) = stack.get_mut(sp) {
-                    *entry = child;
-                    sp += 1;
-                }
-            }
-        }
-    }
-}
-
-/// As [`walk`], with each node mutable (links must not change).
+/// `visit` with each node (which must not change links). Explicit stack: one pending sibling
+/// per level.
 fn walk_mut<S: Scalar>(nodes: &mut [Node<S>], mut visit: impl FnMut(&mut Node<S>)) {
     let mut stack = [0u32; MAX_DEPTH + 2];
     let mut sp = 1usize;
@@ -146,10 +125,9 @@ fn size_class(x: f32) -> usize {
     (x.to_bits() >> 21) as usize
 }
 
-/// Half the surface area, in `f32` (the same formula the builder uses).
+/// Half the surface area of a box, in `f32`.
 fn half_area<S: Scalar>(b: &Aabb<S>) -> f32 {
-    let d: [f32; 3] = core::array::from_fn(|i| b.hi[i].to_f32() - b.lo[i].to_f32());
-    d[0] * d[1] + d[1] * d[2] + d[2] * d[0]
+    super::half_area(&b.lo, &b.hi)
 }
 
 /// The tree and its per-pair bookkeeping: for pair `q` (slots `2q`, `2q + 1`; pair 0 is the
@@ -346,7 +324,7 @@ impl<S: Scalar> Tree<'_, S> {
             *p = Node::EMPTY;
         }
         let mut next = 1u32;
-        walk(nodes, |_, node| {
+        walk_mut(nodes, |node| {
             if node.count == 0 {
                 if let Some(p) = pairs.get_mut(node.first as usize / 2) {
                     p.first = next;
