@@ -38,6 +38,15 @@ pub struct FloatRay {
     k: [u32; 3],
     /// Watertight test: shear constants Sx, Sy, Sz.
     shear: [f32; 3],
+    /// The origin permuted to (kx, ky, kz).
+    o_perm: [f32; 3],
+}
+
+/// `v[k]` for an axis `k < 3` (every `k` of a [`FloatRay`]); `min` shows the compiler the
+/// bound, so no panic path remains.
+#[inline(always)]
+fn axis(v: &[f32; 3], k: u32) -> f32 {
+    v[(k as usize).min(2)]
 }
 
 fn abs(x: f32) -> f32 {
@@ -154,6 +163,7 @@ impl FloatRay {
             o_hi,
             k,
             shear,
+            o_perm: [origin[kx], origin[ky], origin[kz]],
         })
     }
 
@@ -185,34 +195,29 @@ impl FloatRay {
             check_coord(x).map_err(RayError::Origin)?;
         }
         let (o_lo, o_hi) = Self::shifted_origins(origin);
+        let [kx, ky, kz] = self.k;
         Ok(Self {
             origin,
             o_lo,
             o_hi,
+            o_perm: [axis(&origin, kx), axis(&origin, ky), axis(&origin, kz)],
             ..*self
         })
     }
 
-    /// Vertex relative to the origin, permuted to (kx, ky, kz).
+    /// Vertex relative to the origin, permuted to (kx, ky, kz): `v[k] - origin[k]`, the
+    /// same IEEE subtraction whichever order it is done in.
     ///
-    /// Lanes are selected bit for bit with masks (`k[i] == axis`), which keeps the vector in
-    /// registers: indexing it by a variable axis goes through memory, and that store-and-reload
-    /// stalled the triangle test by 20-30% in some processes.
+    /// The vertex is read in permuted order straight from memory. (Permuting it after the
+    /// subtraction, with the vector in registers, went through a store and reload that
+    /// stalled the triangle test.)
     #[inline(always)]
     fn rel_permuted(&self, v: &[f32; 3]) -> [f32; 3] {
-        let p = [
-            (v[0] - self.origin[0]).to_bits(),
-            (v[1] - self.origin[1]).to_bits(),
-            (v[2] - self.origin[2]).to_bits(),
-        ];
-        // Every index below is a constant, so no bounds check (and no panic path) remains even
-        // where the optimiser does not unroll.
-        let lane = |axis: u32| {
-            let mask = |a: u32| if axis == a { u32::MAX } else { 0 };
-            f32::from_bits((p[0] & mask(0)) | (p[1] & mask(1)) | (p[2] & mask(2)))
-        };
-        let [k0, k1, k2] = self.k;
-        [lane(k0), lane(k1), lane(k2)]
+        [
+            axis(v, self.k[0]) - self.o_perm[0],
+            axis(v, self.k[1]) - self.o_perm[1],
+            axis(v, self.k[2]) - self.o_perm[2],
+        ]
     }
 
     /// Sheared 2D coordinates and scaled z of a vertex: the ray becomes the +z axis.
@@ -248,20 +253,46 @@ impl FloatRay {
         })
     }
 
-    /// Distance and barycentrics (of the second and third vertex) from the sheared vertices,
-    /// with the edge functions evaluated in `f64` (exact products, one rounding each).
-    /// `None` if the determinant is zero there. NaN (only from overflow) fails callers' range
-    /// tests.
+    /// Edge functions (U, V, W) of the sheared vertices, their sum `det`, and the scaled
+    /// distance `num = U·az + V·bz + W·cz`, all in `f64` (the `f32` products are exact there;
+    /// one rounding each): `t = num / det`. NaN only from overflow.
     #[inline(always)]
-    fn solve(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> Option<(f32, f32, f32)> {
+    fn scaled(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> ([f64; 3], f64, f64) {
         let e = |p: &[f32; 3], q: &[f32; 3]| p[0] as f64 * q[1] as f64 - p[1] as f64 * q[0] as f64;
         let (u, v, w) = (e(c, b), e(a, c), e(b, a));
-        let det = u + v + w;
+        let num = u * a[2] as f64 + v * b[2] as f64 + w * c[2] as f64;
+        ([u, v, w], u + v + w, num)
+    }
+
+    /// Distance and barycentrics (of the second and third vertex) from the sheared vertices,
+    /// by [`FloatRay::scaled`]. `None` if the determinant is zero there. NaN (only from
+    /// overflow) fails callers' range tests.
+    #[inline(always)]
+    fn solve(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> Option<(f32, f32, f32)> {
+        let ([_, v, w], det, num) = Self::scaled(a, b, c);
         if det == 0.0 {
             return None;
         }
-        let t = (u * a[2] as f64 + v * b[2] as f64 + w * c[2] as f64) / det;
-        Some((t as f32, (v / det) as f32, (w / det) as f32))
+        Some(((num / det) as f32, (v / det) as f32, (w / det) as f32))
+    }
+
+    /// True if `t = (num / det) as f32` (the distance [`FloatRay::solve`] returns) is sure to
+    /// fall outside `[t_min, t_max]`, decided without dividing.
+    ///
+    /// The bounds are widened by `2^-20` relative and `2^-120` absolute. Three roundings to
+    /// `f64` (relative error `2^-53` each) cannot eat that margin, so `num / det` exceeds
+    /// `t_max` by more than an `f32` ulp or reaches the normal range, and rounding it to `f32`
+    /// cannot bring it back into range (likewise below `t_min`). NaN is reported as outside,
+    /// which is what the range test does with a NaN `t`.
+    #[inline(always)]
+    fn surely_outside(num: f64, det: f64, t_min: f32, t_max: f32) -> bool {
+        const REL: f64 = 1.0 / 1_048_576.0; // 2^-20
+        const ABS: f64 = 7.52316384526264e-37; // 2^-120
+        let (lo, hi) = (t_min as f64, t_max as f64);
+        let lo = lo - libm::fabs(lo) * REL - ABS;
+        let hi = hi + libm::fabs(hi) * REL + ABS; // +inf stays +inf
+        let (n, d) = if det < 0.0 { (-num, -det) } else { (num, det) };
+        !(n >= d * lo && n <= d * hi)
     }
 
     /// The three edge functions (U, V, W) of the sheared triangle, with the exact `f64`
@@ -271,7 +302,7 @@ impl FloatRay {
         let u = c[0] * b[1] - c[1] * b[0];
         let v = a[0] * c[1] - a[1] * c[0];
         let w = b[0] * a[1] - b[1] * a[0];
-        if u == 0.0 || v == 0.0 || w == 0.0 {
+        if (u == 0.0) | (v == 0.0) | (w == 0.0) {
             let f = |p: &[f32; 3], q: &[f32; 3]| {
                 (p[0] as f64 * q[1] as f64 - p[1] as f64 * q[0] as f64) as f32
             };
@@ -453,9 +484,12 @@ impl Scalar for f32 {
         let a = r.shear(&v[0]);
         let b = r.shear(&v[1]);
         let c = r.shear(&v[2]);
-        // Edge functions; two-sided, so reject only if the signs differ.
+        // Edge functions; two-sided, so reject only if the signs differ. (Non-short-circuit
+        // operators: one branch instead of six hard-to-predict ones.)
         let [eu, ev, ew] = FloatRay::edges(&a, &b, &c);
-        if (eu < 0.0 || ev < 0.0 || ew < 0.0) && (eu > 0.0 || ev > 0.0 || ew > 0.0) {
+        let negative = (eu < 0.0) | (ev < 0.0) | (ew < 0.0);
+        let positive = (eu > 0.0) | (ev > 0.0) | (ew > 0.0);
+        if negative & positive {
             return None;
         }
         if eu + ev + ew == 0.0 {
@@ -463,8 +497,13 @@ impl Scalar for f32 {
         }
         // The signs above decide hit or miss (watertight). For the distance, recompute the
         // edge functions in f64, where the f32 products are exact: on slivers the f32 values
-        // keep too few bits for an accurate t. Rare path: candidates only.
-        let (t, _, _) = FloatRay::solve(&a, &b, &c)?;
+        // keep too few bits for an accurate t. Rare path: candidates only, most of which lie
+        // beyond the best hit so far and are dropped before the division.
+        let (_, det, num) = FloatRay::scaled(&a, &b, &c);
+        if det == 0.0 || FloatRay::surely_outside(num, det, t_min, t_max) {
+            return None;
+        }
+        let t = (num / det) as f32;
         if !(t >= t_min && t <= t_max) {
             return None;
         }
@@ -542,6 +581,74 @@ impl Scalar for f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `surely_outside` may only reject what the exact range test rejects, and must reject
+    /// what lies clearly outside. Distances are drawn around the interval ends (relative
+    /// offsets down to 2^-60, either sign), with determinants from 2^-140 to 2^140.
+    #[test]
+    fn surely_outside_rejects_only_what_the_range_test_rejects() {
+        let tiny = f32::from_bits(1);
+        let ends = [
+            0.0,
+            tiny,
+            1e-40,
+            1e-30,
+            0.25,
+            1.0,
+            123.4,
+            1e30,
+            f32::MAX,
+            f32::INFINITY,
+        ];
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let (mut rejected, mut checked) = (0u32, 0u32);
+        for (i, &t_min) in ends.iter().enumerate() {
+            for &t_max in &ends[i..] {
+                if t_min == f32::INFINITY {
+                    continue;
+                }
+                for _ in 0..2000 {
+                    let r = next();
+                    let det_exp = (r % 281) as i32 - 140;
+                    let mantissa = 1.0 + (r >> 12) as f64 / (1u64 << 52) as f64;
+                    let det =
+                        mantissa * libm::exp2(det_exp as f64) * if r & 1 == 0 { 1.0 } else { -1.0 };
+                    let end = if r & 2 == 0 { t_min } else { t_max } as f64;
+                    let offset =
+                        libm::exp2(-((next() % 61) as f64)) * if r & 4 == 0 { 1.0 } else { -1.0 };
+                    let q = match next() % 4 {
+                        0 => end * (1.0 + offset),
+                        1 => end + offset * 1e-38,
+                        2 => end * 2.0 + 1e-36,
+                        _ => -offset,
+                    };
+                    let num = q * det;
+                    let t = (num / det) as f32;
+                    let in_range = t >= t_min && t <= t_max;
+                    checked += 1;
+                    if FloatRay::surely_outside(num, det, t_min, t_max) {
+                        rejected += 1;
+                        assert!(
+                            !in_range,
+                            "{num:e} / {det:e} = {t:e} is in [{t_min:e}, {t_max:e}]"
+                        );
+                    } else if t_max.is_finite() && q > 2.0 * t_max as f64 + 1e-36 {
+                        panic!("{num:e} / {det:e} lies clearly beyond {t_max:e} but was kept");
+                    }
+                }
+            }
+        }
+        // Candidates clearly out of range (a quarter of the draws at least) are rejected.
+        assert!(rejected > checked / 4, "{rejected} of {checked}");
+        assert!(FloatRay::surely_outside(f64::NAN, 1.0, 0.0, 1.0));
+        assert!(!FloatRay::surely_outside(1.0, 1.0, 0.0, f32::INFINITY));
+    }
 
     #[test]
     fn step_moves_one_ulp_each_way() {
