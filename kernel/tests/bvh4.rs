@@ -14,9 +14,7 @@ use common::{c, query, same_hit, with_bvh, with_bvh4, RaySpec, Rng, TestScalar, 
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
 use raykernel::error::Arena;
-use raykernel::{
-    Accel, BuildError, Bvh, Bvh4, Linear, Node, Node4, Ray, Scalar, Triangle, I16F16,
-};
+use raykernel::{Accel, BuildError, Bvh, Bvh4, Linear, Node, Node4, Ray, Scalar, Triangle, I16F16};
 
 fn tri<S: TestScalar>(v: [[f32; 3]; 3]) -> Triangle<S> {
     Triangle::from_f32(v).unwrap_or_else(|e| panic!("{} {v:?}: {e:?}", S::NAME))
@@ -98,7 +96,10 @@ fn slab4_cases<S: TestScalar>() {
         }
     }
     // Both outcomes are well represented.
-    assert!(accepted > 20_000 && rejected > 20_000, "{accepted} {rejected}");
+    assert!(
+        accepted > 20_000 && rejected > 20_000,
+        "{accepted} {rejected}"
+    );
 }
 
 #[test]
@@ -143,8 +144,7 @@ fn slab4_axis_cases<S: TestScalar>() {
                             for b in 0..4 {
                                 let l = [lo[0][b], lo[1][b], lo[2][b]];
                                 let h = [hi[0][b], hi[1][b], hi[2][b]];
-                                let want =
-                                    S::slab(ray.data(), &l, &h, ray.t_min(), ray.t_max());
+                                let want = S::slab(ray.data(), &l, &h, ray.t_min(), ray.t_max());
                                 let got = (mask & (1 << b) != 0).then_some(t[b]);
                                 assert_eq!(
                                     got.map(|v| v.bits()),
@@ -269,7 +269,10 @@ fn nodes4_needed_values_and_growth() {
     let mut prev = 0;
     for n in 0..200_000 {
         let w = nodes4_needed(n);
-        assert!(w >= prev && w <= n.max(1) && 3 * w <= 2 * n + 3, "n = {n}: {w}");
+        assert!(
+            w >= prev && w <= n.max(1) && 3 * w <= 2 * n + 3,
+            "n = {n}: {w}"
+        );
         prev = w;
     }
     // Large counts do not overflow.

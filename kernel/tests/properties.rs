@@ -19,8 +19,8 @@
 mod common;
 
 use common::{
-    all_options, dir_to, query, same_hit, with_bvh, with_bvh4, with_grid, with_kdtree, RaySpec, TestScalar,
-    GRID_DENSITIES, KD_DEPTHS,
+    all_options, dir_to, query, same_hit, with_bvh, with_bvh4, with_grid, with_kdtree, RaySpec,
+    TestScalar, GRID_DENSITIES, KD_DEPTHS,
 };
 use proptest::prelude::*;
 use proptest::test_runner::{Config as ProptestConfig, RngSeed};
@@ -354,14 +354,17 @@ fn check_differential<S: TestScalar, P: Primitive<S> + std::fmt::Debug>(
             // The 4-wide BVH collapsed from this tree: validates, fits the documented bound,
             // and answers exactly as Linear does.
             with_bvh4(bvh, |wide| -> Result<(), String> {
-                let stats = wide.validate().map_err(|e| ctx(format!("bvh4 validate: {e}")))?;
+                let stats = wide
+                    .validate()
+                    .map_err(|e| ctx(format!("bvh4 validate: {e}")))?;
                 if stats.node_count > nodes4_needed(prims.len()) {
                     return Err(ctx(format!("bvh4 uses {} nodes", stats.node_count)));
                 }
                 for (r, want) in rays.iter().zip(&want) {
-                    let got =
-                        query(wide, &r.ray::<S>()).map_err(|e| ctx(format!("bvh4 {e}, ray {r}")))?;
-                    same_hit(&got, want).map_err(|e| ctx(format!("BVH4 vs Linear: {e}, ray {r}")))?;
+                    let got = query(wide, &r.ray::<S>())
+                        .map_err(|e| ctx(format!("bvh4 {e}, ray {r}")))?;
+                    same_hit(&got, want)
+                        .map_err(|e| ctx(format!("BVH4 vs Linear: {e}, ray {r}")))?;
                 }
                 Ok(())
             })
