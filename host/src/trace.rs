@@ -454,7 +454,7 @@ pub struct NodeArena<S: Scalar> {
     /// Grid or kd-tree references.
     refs: Vec<u32>,
     kd_nodes: Vec<KdNode<S>>,
-    /// 4-wide BVH nodes (`Node4` is 64-byte aligned, so the vector is too).
+    /// 4-wide BVH nodes (`Node4` is 128-byte aligned, so the vector is too).
     nodes4: Vec<Node4<S>>,
 }
 

@@ -25,15 +25,10 @@ type Entry<S> = (u32, u32, S);
 /// Compare-exchange: `e[i]` before `e[j]` unless `e[j]` is strictly nearer.
 #[inline(always)]
 fn cmpx<S: Scalar>(e: &mut [Entry<S>; 4], i: usize, j: usize) {
-    if let (Some(&a), Some(&b)) = (e.get(i), e.get(j)) {
-        if b.2 < a.2 {
-            if let Some(x) = e.get_mut(i) {
-                *x = b;
-            }
-            if let Some(x) = e.get_mut(j) {
-                *x = a;
-            }
-        }
+    let (a, b) = (e[i & 3], e[j & 3]);
+    if b.2 < a.2 {
+        e[i & 3] = b;
+        e[j & 3] = a;
     }
 }
 
@@ -88,19 +83,22 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                         stats.node();
                     }
                     let (hit, t) = S::slab4(rd, &node.lo, &node.hi, t_min, best_t);
-                    let mut hit = hit & used;
+                    let hit = hit & used;
+                    if hit.count_ones() == 1 {
+                        // One child hit (the common case deep in the tree): go there.
+                        let i = hit.trailing_zeros() as usize & 3;
+                        (child, count) = (node.child[i], node.count[i]);
+                        continue 'walk;
+                    }
                     // Hit children, compacted, then nearest first.
                     let mut e: [Entry<S>; 4] = [(0, 0, t_min); 4];
                     let mut n = 0usize;
-                    while hit != 0 {
-                        let i = (hit.trailing_zeros() as usize).min(3);
-                        hit &= hit - 1;
-                        if let (Some(slot), Some(&c), Some(&k), Some(&t)) =
-                            (e.get_mut(n), node.child.get(i), node.count.get(i), t.get(i))
-                        {
-                            *slot = (c, k, t);
-                            n += 1;
-                        }
+                    let mut rest = hit;
+                    while rest != 0 {
+                        let i = rest.trailing_zeros() as usize & 3;
+                        rest &= rest - 1;
+                        e[n & 3] = (node.child[i], node.count[i], t[i]);
+                        n += 1;
                     }
                     sort_nearest_first(&mut e, n);
                     if let Some((&(c, k, _), rest)) = e.get(..n).and_then(<[_]>::split_first) {
