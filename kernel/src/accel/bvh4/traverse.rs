@@ -84,11 +84,26 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                     }
                     let (hit, t) = S::slab4(rd, &node.lo, &node.hi, t_min, best_t);
                     let hit = hit & used;
-                    if hit.count_ones() == 1 {
-                        // One child hit (the common case deep in the tree): go there.
+                    if hit != 0 {
                         let i = hit.trailing_zeros() as usize & 3;
-                        (child, count) = (node.child[i], node.count[i]);
-                        continue 'walk;
+                        let others = hit & (hit - 1);
+                        if others == 0 {
+                            // One child hit (the common case deep in the tree): go there.
+                            (child, count) = (node.child[i], node.count[i]);
+                            continue 'walk;
+                        }
+                        let j = others.trailing_zeros() as usize & 3;
+                        if others & (others - 1) == 0 {
+                            // Two: visit the nearer (the first on a tie), push the other.
+                            let (a, b) = (
+                                (node.child[i], node.count[i], t[i]),
+                                (node.child[j], node.count[j], t[j]),
+                            );
+                            let (near, far) = if b.2 < a.2 { (b, a) } else { (a, b) };
+                            let _ = stack.push(far);
+                            (child, count) = (near.0, near.1);
+                            continue 'walk;
+                        }
                     }
                     // Hit children, compacted, then nearest first.
                     let mut e: [Entry<S>; 4] = [(0, 0, t_min); 4];
