@@ -123,6 +123,8 @@ pub fn variants() -> Vec<Variant> {
             AccelKind::Linear | AccelKind::Grid | AccelKind::Kdtree => {
                 vec![BuildOptions::default()]
             }
+            // Trace only: the renderer has no 4-wide BVH.
+            AccelKind::Bvh4 => Vec::new(),
         };
         for build in builds {
             v.push(Variant {

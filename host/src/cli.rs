@@ -528,6 +528,11 @@ pub fn run_render(args: &RenderArgs) -> Result<RenderReport, Error> {
     let settings = spec.settings;
     let data = spec.data();
     let mode = args.mode;
+    if args.accel == AccelKind::Bvh4 {
+        return Err(Error::Usage(
+            "--accel bvh4 is for `host trace` only: the renderer has no 4-wide BVH".into(),
+        ));
+    }
     let accel = accel_choice(
         args.accel,
         BuildOptions {
@@ -641,9 +646,11 @@ pub fn run_check(args: &CheckArgs) -> Result<CheckReport, Error> {
 /// # Errors
 /// Bad or unreadable inputs, an unwritable output, or a build the kernel refuses.
 pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
-    if args.leaf_order && args.accel != AccelKind::Bvh {
+    let bvh_family = matches!(args.accel, AccelKind::Bvh | AccelKind::Bvh4);
+    if args.leaf_order && !bvh_family {
         return Err(Error::Usage(
-            "--leaf-order needs --accel bvh (the other accelerators do not permute primitives)"
+            "--leaf-order needs --accel bvh or bvh4 (the other accelerators do not permute \
+             primitives)"
                 .into(),
         ));
     }
@@ -676,10 +683,10 @@ pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
         rays_file: args.rays.display().to_string(),
         out: args.out.display().to_string(),
         accel: args.accel.name(),
-        builder: (args.accel == AccelKind::Bvh).then(|| BuilderKind::from(args.builder).name()),
+        builder: bvh_family.then(|| BuilderKind::from(args.builder).name()),
         mode: args.mode.name(),
         leaf: args.leaf,
-        reinsertion: args.accel == AccelKind::Bvh && !args.no_reinsertion,
+        reinsertion: bvh_family && !args.no_reinsertion,
         leaf_order: args.leaf_order,
         runs: args.runs,
         stride: args.stride,

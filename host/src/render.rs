@@ -30,6 +30,9 @@ pub fn accel_choice(kind: AccelKind, build: BuildOptions) -> AccelChoice {
         AccelKind::Linear => AccelChoice::Linear,
         AccelKind::Grid => AccelChoice::Grid(GridOptions::default()),
         AccelKind::Kdtree => AccelChoice::KdTree(KdOptions::default()),
+        // The renderer has no 4-wide BVH (`host render` refuses it); the BVH it is collapsed
+        // from gives the same image bits.
+        AccelKind::Bvh4 => AccelChoice::Bvh(build),
     }
 }
 

@@ -6,14 +6,19 @@
 //! [`build_and_visit`] builds whichever [`AccelKind`] is asked for (timed) and hands it to an
 //! [`AccelVisitor`]; [`prepare_rays`] and [`trace_closest`] are the timed halves of a trace.
 //! A new accelerator is a new [`AccelKind`] variant plus one arm in [`build_and_visit`].
+//!
+//! [`AccelKind::Bvh4`] builds the BVH (timed) and collapses it into the 4-wide tree (timed
+//! too); the BVH's node arena is build scratch, so its figures count only the wide nodes and
+//! the primitive ids the queries read.
 
 use crate::error::Error;
 use crate::obj::Mesh;
 use crate::rayfile::{HitRecord, RayRecord};
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
+use raykernel::bvh4::nodes4_needed;
 use raykernel::{
-    kdtree, Accel, Bvh, Grid, GridOptions, KdNode, KdOptions, KdTree, Linear, Node, Primitive, Ray,
-    Scalar, Triangle, I16F16,
+    kdtree, Accel, Bvh, Bvh4, Grid, GridOptions, KdNode, KdOptions, KdTree, Linear, Node, Node4,
+    Primitive, Ray, Scalar, Triangle, I16F16,
 };
 use std::path::Path;
 use std::time::Instant;
@@ -29,10 +34,14 @@ pub enum AccelKind {
     Grid,
     /// The kernel's kd-tree (SAH, automatic depth).
     Kdtree,
+    /// The kernel's 4-wide BVH, collapsed from the BVH (same builder options). Trace only:
+    /// the renderer has no 4-wide BVH, and the benchmark does not run it yet.
+    Bvh4,
 }
 
 impl AccelKind {
-    /// Every accelerator, in command-line order. Benchmarks iterate over this list.
+    /// Every accelerator the benchmark compares, in command-line order (not
+    /// [`AccelKind::Bvh4`], which `host trace` alone offers so far).
     pub const ALL: [AccelKind; 4] = [Self::Bvh, Self::Linear, Self::Grid, Self::Kdtree];
 
     /// True for brute force, the reference: too slow for whole benchmark ray sets.
@@ -44,7 +53,7 @@ impl AccelKind {
     /// True if the build takes a [`BuilderKind`] (otherwise the builder is ignored).
     #[must_use]
     pub fn uses_builder(self) -> bool {
-        matches!(self, Self::Bvh)
+        matches!(self, Self::Bvh | Self::Bvh4)
     }
 
     /// Name as on the command line.
@@ -55,6 +64,7 @@ impl AccelKind {
             Self::Linear => "linear",
             Self::Grid => "grid",
             Self::Kdtree => "kdtree",
+            Self::Bvh4 => "bvh4",
         }
     }
 }
@@ -140,7 +150,7 @@ pub struct AccelConfig {
     pub accel: AccelKind,
     /// Builder and leaf size (ignored unless [`AccelKind::uses_builder`]).
     pub build: BuildOptions,
-    /// Permute the primitives into leaf order (BVH only).
+    /// Permute the primitives into leaf order (BVH and 4-wide BVH only).
     pub leaf_order: bool,
 }
 
@@ -343,6 +353,31 @@ pub fn build_and_visit<S: Scalar, P: Primitive<S> + Copy, V: AccelVisitor<S>>(
             let build_ms = millis(start);
             Ok((bvh_figures(&bvh, build_ms), visitor.visit(&bvh)))
         }
+        AccelKind::Bvh4 => {
+            // As the BVH arms (leaf order on a fresh copy, untimed), then the collapse.
+            let mut own = if config.leaf_order {
+                prims.to_vec()
+            } else {
+                Vec::new()
+            };
+            let mut ids = vec![0u32; prims.len()];
+            let (nodes, nodes4) = arena.bvh4_slots();
+            let start = Instant::now();
+            let bvh = if config.leaf_order {
+                Bvh::build_in_leaf_order(&mut own, nodes, &mut ids, config.build)
+            } else {
+                Bvh::build(prims, nodes, &mut ids, config.build)
+            }
+            .map_err(build_error)?;
+            let wide = Bvh4::collapse(&bvh, nodes4).map_err(build_error)?;
+            let figures = BuildFigures {
+                build_ms: millis(start),
+                nodes: wide.nodes().len(),
+                accel_bytes: wide.bytes_used(),
+                depth: wide.depth(),
+            };
+            Ok((figures, visitor.visit(&wide)))
+        }
         AccelKind::Grid => {
             // The counting pass is part of the timed build, as a caller sizing memory does it.
             let options = GridOptions::default();
@@ -419,6 +454,8 @@ pub struct NodeArena<S: Scalar> {
     /// Grid or kd-tree references.
     refs: Vec<u32>,
     kd_nodes: Vec<KdNode<S>>,
+    /// 4-wide BVH nodes (`Node4` is 128-byte aligned, so the vector is too).
+    nodes4: Vec<Node4<S>>,
 }
 
 impl<S: Scalar> NodeArena<S> {
@@ -432,6 +469,10 @@ impl<S: Scalar> NodeArena<S> {
         let mut arena = Self::with_slots(0);
         match accel {
             AccelKind::Bvh => arena = Self::with_slots(nodes_needed(n)),
+            AccelKind::Bvh4 => {
+                arena = Self::with_slots(nodes_needed(n));
+                arena.nodes4 = vec![Node4::EMPTY; nodes4_needed(n)];
+            }
             AccelKind::Linear => {}
             AccelKind::Grid => {
                 if let Ok(size) = Grid::size_for(prims, GridOptions::default()) {
@@ -456,6 +497,7 @@ impl<S: Scalar> NodeArena<S> {
             words: Vec::new(),
             refs: Vec::new(),
             kd_nodes: Vec::new(),
+            nodes4: Vec::new(),
         }
     }
 
@@ -465,6 +507,14 @@ impl<S: Scalar> NodeArena<S> {
         let skip = usize::from(misaligned);
         let len = self.nodes.len() - 1;
         &mut self.nodes[skip..skip + len]
+    }
+
+    /// The BVH slots (as [`NodeArena::slots`]) and the 4-wide nodes, for [`AccelKind::Bvh4`].
+    pub fn bvh4_slots(&mut self) -> (&mut [Node<S>], &mut [Node4<S>]) {
+        let misaligned = !(self.nodes.as_ptr() as usize).is_multiple_of(Self::LINE);
+        let skip = usize::from(misaligned);
+        let len = self.nodes.len() - 1;
+        (&mut self.nodes[skip..skip + len], &mut self.nodes4)
     }
 }
 

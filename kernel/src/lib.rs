@@ -41,6 +41,7 @@ pub mod render;
 pub mod scalar;
 
 pub use accel::bvh::{self, Bvh, Node};
+pub use accel::bvh4::{self, Bvh4, Node4};
 pub use accel::grid::{self, Grid, GridOptions};
 pub use accel::kdtree::{self, KdNode, KdOptions, KdTree};
 pub use accel::{Accel, Counters, Linear, Nearest, NoStats, TraversalStats};

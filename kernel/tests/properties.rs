@@ -2,6 +2,8 @@
 //! and leaf sizes 1, 2, 4 and 8:
 //! - the tree passes `validate()` after every build (and respects the leaf size);
 //! - the BVH's closest hit equals brute force (`Linear`) bit for bit: t, primitive, u and v;
+//! - so does that of the 4-wide BVH collapsed from each tree (validated, within
+//!   `nodes4_needed`);
 //! - so do the uniform grid's (densities 0.25, 2 and 8, each built into arenas of exactly the
 //!   counted size and validated) and the kd-tree's (automatic depth, depth 3 and the maximum,
 //!   built into the documented budgets and validated);
@@ -17,12 +19,13 @@
 mod common;
 
 use common::{
-    all_options, dir_to, query, same_hit, with_bvh, with_grid, with_kdtree, RaySpec, TestScalar,
-    GRID_DENSITIES, KD_DEPTHS,
+    all_options, dir_to, query, same_hit, with_bvh, with_bvh4, with_grid, with_kdtree, RaySpec,
+    TestScalar, GRID_DENSITIES, KD_DEPTHS,
 };
 use proptest::prelude::*;
 use proptest::test_runner::{Config as ProptestConfig, RngSeed};
 use raykernel::bvh::BuildOptions;
+use raykernel::bvh4::nodes4_needed;
 use raykernel::{Accel, GridOptions, KdOptions, Linear, Primitive, Sphere, Triangle, I16F16};
 
 const SEED: u64 = 0x5eed_7a11_0001;
@@ -348,7 +351,23 @@ fn check_differential<S: TestScalar, P: Primitive<S> + std::fmt::Debug>(
                     ))
                 })?;
             }
-            Ok(())
+            // The 4-wide BVH collapsed from this tree: validates, fits the documented bound,
+            // and answers exactly as Linear does.
+            with_bvh4(bvh, |wide| -> Result<(), String> {
+                let stats = wide
+                    .validate()
+                    .map_err(|e| ctx(format!("bvh4 validate: {e}")))?;
+                if stats.node_count > nodes4_needed(prims.len()) {
+                    return Err(ctx(format!("bvh4 uses {} nodes", stats.node_count)));
+                }
+                for (r, want) in rays.iter().zip(&want) {
+                    let got = query(wide, &r.ray::<S>())
+                        .map_err(|e| ctx(format!("bvh4 {e}, ray {r}")))?;
+                    same_hit(&got, want)
+                        .map_err(|e| ctx(format!("BVH4 vs Linear: {e}, ray {r}")))?;
+                }
+                Ok(())
+            })
         })?;
     }
     // The uniform grid and the kd-tree: the same answers, bit for bit.

@@ -1,10 +1,11 @@
 //! Accelerators: one query API over every structure, so results can be compared bit for bit.
 //!
 //! The lecture's three ways to avoid testing every object: a bounding volume hierarchy
-//! ([`bvh`]), a uniform spatial subdivision ([`grid`]) and an axis-aligned binary space
+//! ([`bvh`], and its 4-wide form [`bvh4`]), a uniform spatial subdivision ([`grid`]) and an axis-aligned binary space
 //! partition ([`kdtree`]); and brute force ([`Linear`]), the reference.
 
 pub mod bvh;
+pub mod bvh4;
 pub mod grid;
 pub mod kdtree;
 mod linear;

@@ -567,6 +567,17 @@ impl Scalar for f32 {
         }
     }
 
+    #[inline(always)]
+    fn slab4(
+        r: &FloatRay,
+        lo: &[[f32; 4]; 3],
+        hi: &[[f32; 4]; 3],
+        t_min: f32,
+        t_max: f32,
+    ) -> (u32, [f32; 4]) {
+        super::wide::slab4(r.o_lo, r.o_hi, r.inv, WIDEN, lo, hi, t_min, t_max)
+    }
+
     fn sphere_bounds(center: &[f32; 3], radius: f32) -> ([f32; 3], [f32; 3]) {
         let mut lo = [0.0; 3];
         let mut hi = [0.0; 3];

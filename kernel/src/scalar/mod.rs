@@ -8,6 +8,7 @@
 mod fixed;
 mod float;
 mod lanes;
+mod wide;
 
 pub use fixed::{FixedRay, Vec3x, FIXED_COORD_LIMIT, I16F16};
 pub use float::{FloatRay, F32_COORD_LIMIT};
@@ -124,6 +125,35 @@ pub trait Scalar:
             Self::slab(ray, a.0, a.1, t_min, t_max),
             Self::slab(ray, b.0, b.1, t_min, t_max),
         ]
+    }
+    /// [`Scalar::slab`] of four boxes at once (a 4-wide BVH node's children), given as
+    /// structure of arrays: `lo[axis][box]`, `hi[axis][box]`. Returns a mask (bit `i` set if box
+    /// `i` is accepted) and the entry distances; for every accepted box the distance has the
+    /// same bits as `slab` gives, and the accept/reject decisions are `slab`'s. Entries of
+    /// rejected boxes are unspecified.
+    ///
+    /// The default runs `slab` per box; `f32` computes the four boxes in the lanes of
+    /// one vector (`scalar/wide.rs`), with each lane doing `slab`'s operations in its order.
+    #[inline(always)]
+    fn slab4(
+        ray: &Self::RayData,
+        lo: &[[Self; 4]; 3],
+        hi: &[[Self; 4]; 3],
+        t_min: Self,
+        t_max: Self,
+    ) -> (u32, [Self; 4]) {
+        let mut mask = 0u32;
+        let mut t = [t_min; 4];
+        for (i, slot) in t.iter_mut().enumerate() {
+            let i = i.min(3); // a no-op that shows the compiler the bound
+            let l = [lo[0][i], lo[1][i], lo[2][i]];
+            let h = [hi[0][i], hi[1][i], hi[2][i]];
+            if let Some(near) = Self::slab(ray, &l, &h, t_min, t_max) {
+                *slot = near;
+                mask |= 1 << i;
+            }
+        }
+        (mask, t)
     }
     /// `t >= 0` widened by the slab test's margin: the test accepts boxes entered up to
     /// `widen(t)`.

@@ -2,9 +2,10 @@
 #![allow(dead_code)]
 
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
+use raykernel::bvh4::nodes4_needed;
 use raykernel::{
-    kdtree, Accel, Bvh, Grid, GridOptions, Hit, KdNode, KdOptions, KdTree, Node, PointError,
-    Primitive, Ray, Scalar, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16,
+    kdtree, Accel, Bvh, Bvh4, Grid, GridOptions, Hit, KdNode, KdOptions, KdTree, Node, Node4,
+    PointError, Primitive, Ray, Scalar, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16,
 };
 use std::fmt;
 use std::ops::{Add, Mul, Sub};
@@ -192,6 +193,24 @@ where
         )
     });
     f(&bvh)
+}
+
+/// Collapses `bvh` into a 4-wide BVH in an arena of exactly [`nodes4_needed`] slots and hands
+/// it to `f` (validation is the caller's).
+pub fn with_bvh4<S, P, R>(bvh: &Bvh<'_, S, P>, f: impl FnOnce(&Bvh4<'_, S, P>) -> R) -> R
+where
+    S: Scalar,
+    P: Primitive<S>,
+{
+    let mut nodes = vec![Node4::<S>::EMPTY; nodes4_needed(bvh.prims().len())];
+    let wide = Bvh4::collapse(bvh, &mut nodes).unwrap_or_else(|e| {
+        panic!(
+            "{} bvh4 collapse ({} prims) failed: {e}",
+            S::NAME,
+            bvh.prims().len()
+        )
+    });
+    f(&wide)
 }
 
 /// Grid densities the differential tests build with: coarse, the default, fine.

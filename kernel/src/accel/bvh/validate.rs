@@ -153,7 +153,7 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
 
 /// Every id in `0..ids.len()` exactly once, checked window by window with a fixed bitmap (no
 /// allocation): `O(n²/8192)` work, fine for the sizes tests use.
-fn check_permutation(ids: &[u32]) -> Result<(), InvalidTree> {
+pub(crate) fn check_permutation(ids: &[u32]) -> Result<(), InvalidTree> {
     const WINDOW: usize = 8192;
     let n = ids.len();
     let mut base = 0usize;

@@ -1,0 +1,127 @@
+//! A 4-wide BVH, collapsed from a built binary [`Bvh`], over caller-provided memory.
+//!
+//! Each [`Node4`] holds the boxes of up to four children side by side, so traversal tests
+//! them at once (`f32`: one vector lane per child, [`Scalar::slab4`]; fixed point: `slab`
+//! per child) and visits the hit children nearest first. The collapse is the standard one
+//! (e.g. Wald et al. 2008, "Getting rid of packets"; Áfra et al. 2016 for the collapse order):
+//! a wide node starts from a BVH2 inner node's two children and repeatedly opens the inner
+//! child with the largest surface area, replacing it by its two children, until it has four
+//! children or none is inner. BVH2 leaves become leaf children as they are, referencing the
+//! same `prim_ids` ranges, so a [`Bvh4`] borrows the primitive ids and primitives of the
+//! [`Bvh`] it came from (leaf order included). The BVH2 node arena is only build scratch:
+//! once collapsed, queries read the [`Node4`] arena, the ids and the primitives.
+//!
+//! [`Bvh4::collapse`] is iterative and needs no stack: wide nodes are laid out breadth-first
+//! and the arena itself is the work queue (a node still to fill holds its BVH2 source). Every
+//! box is the BVH2 node's box bit for bit, and every query returns exactly what [`Bvh`] and
+//! [`crate::Linear`] return.
+
+mod collapse;
+mod node;
+mod traverse;
+mod validate;
+
+pub use node::Node4;
+
+use crate::accel::bvh::Bvh;
+use crate::error::BuildError;
+use crate::geom::Primitive;
+use crate::scalar::Scalar;
+use core::marker::PhantomData;
+
+/// Node slots [`Bvh4::collapse`] needs in the worst case for a tree over `prim_count`
+/// primitives: 0 for none, 1 for up to four, otherwise `max(4a + 1, n - 3 - 2a)` with
+/// `a = ⌊(n - 2) / 6⌋`, about `2n/3`.
+///
+/// Proof. Each wide node stems from a distinct BVH2 inner node, and a wide node with fewer
+/// than four children has only leaf children (opening stops early only when no inner child
+/// is left). Let `F` nodes have four children and `M` fewer (two or three leaves each),
+/// `W = F + M`, with `L <= n` leaves. Children that are nodes number `W - 1`, all in the `F` full
+/// nodes, so `W - 1 <= 4F`, i.e. `M <= 3F + 1`; and `L >= 2M + (4F - (W - 1)) = M + 3F + 1`.
+/// Maximising `F + M` under `M <= 3F + 1` and `M <= L - 1 - 3F` gives the formula (the optimum
+/// is at `F = a` or `F = a + 1`), which grows with `L`, so `L = n` bounds it. The bound is
+/// reached, e.g. by a perfect binary tree of 8 leaves (5 wide nodes).
+#[must_use]
+pub const fn nodes4_needed(prim_count: usize) -> usize {
+    match prim_count {
+        0 => 0,
+        1..=4 => 1,
+        n => {
+            let a = (n - 2) / 6;
+            let full_first = 4 * a + 1;
+            let small_first = n - 3 - 2 * a;
+            if full_first > small_first {
+                full_first
+            } else {
+                small_first
+            }
+        }
+    }
+}
+
+/// A 4-wide BVH, borrowing its nodes and the primitive ids and primitives of the [`Bvh`] it
+/// was collapsed from.
+#[derive(Clone, Copy, Debug)]
+pub struct Bvh4<'a, S: Scalar, P: Primitive<S>> {
+    nodes: &'a [Node4<S>],
+    prim_ids: &'a [u32],
+    prims: &'a [P],
+    /// Depth of the deepest wide node (root = 0); at most that of the BVH2's deepest inner
+    /// node, so below [`crate::bvh::MAX_DEPTH`].
+    depth: u32,
+    /// As [`Bvh::is_leaf_order`]: `prims[i]` is the primitive with id `prim_ids[i]`.
+    leaf_order: bool,
+    _scalar: PhantomData<S>,
+}
+
+impl<'a, S: Scalar, P: Primitive<S>> Bvh4<'a, S, P> {
+    /// Collapses `bvh` into `nodes` (at least [`nodes4_needed`]`(bvh.prims().len())` slots).
+    /// Allocation-free, no recursion, deterministic.
+    ///
+    /// # Errors
+    /// [`BuildError::ArenaTooSmall`] (arena [`crate::Arena::Nodes`]) with the exact bound.
+    pub fn collapse(bvh: &Bvh<'a, S, P>, nodes: &'a mut [Node4<S>]) -> Result<Self, BuildError> {
+        let (count, depth) = collapse::collapse(bvh.nodes(), nodes, bvh.prims().len())?;
+        let nodes: &'a [Node4<S>] = nodes;
+        Ok(Self {
+            nodes: nodes.get(..count).unwrap_or_default(),
+            prim_ids: bvh.prim_ids(),
+            prims: bvh.prims(),
+            depth,
+            leaf_order: bvh.is_leaf_order(),
+            _scalar: PhantomData,
+        })
+    }
+
+    /// The nodes in use (root first, breadth-first order).
+    #[must_use]
+    pub fn nodes(&self) -> &'a [Node4<S>] {
+        self.nodes
+    }
+    /// Primitive ids in leaf order (the source BVH's).
+    #[must_use]
+    pub fn prim_ids(&self) -> &'a [u32] {
+        self.prim_ids
+    }
+    /// The primitives (in leaf order if the source BVH was built in leaf order).
+    #[must_use]
+    pub fn prims(&self) -> &'a [P] {
+        self.prims
+    }
+    /// True if the primitives are in leaf order.
+    #[must_use]
+    pub fn is_leaf_order(&self) -> bool {
+        self.leaf_order
+    }
+    /// Depth of the deepest wide node (root = 0).
+    #[must_use]
+    pub fn depth(&self) -> u32 {
+        self.depth
+    }
+    /// Bytes a query reads besides the primitives: the wide nodes in use and the primitive
+    /// ids (the BVH2 node arena it was collapsed from is not needed after the collapse).
+    #[must_use]
+    pub fn bytes_used(&self) -> usize {
+        core::mem::size_of_val(self.nodes) + core::mem::size_of_val(self.prim_ids)
+    }
+}

@@ -1,0 +1,181 @@
+//! Stack-based traversal of the 4-wide tree, nearest child first. One routine serves closest
+//! hit and any hit.
+
+use super::Bvh4;
+use crate::accel::bvh::MAX_DEPTH;
+use crate::accel::{Accel, Counters, Nearest};
+use crate::geom::{closer, Primitive, Ray};
+use crate::scalar::Scalar;
+
+/// Traversal stack capacity.
+///
+/// Bound: a wide node at depth `d` (root 0) stems from a BVH2 inner node at depth `>= d`
+/// (each wide level descends at least one BVH2 level), and BVH2 leaves are at most
+/// [`MAX_DEPTH`] deep, so BVH2 inner nodes and hence wide nodes sit at depths
+/// `0..=MAX_DEPTH - 1`. Visiting a node pushes its hit children but the nearest: at most 3.
+/// While the walk is inside the subtree of a node's child, the stack holds at most 3 entries
+/// per ancestor of that child (their children not yet visited), so at most `3·d` on entering
+/// a node at depth `d`, and at most `3·d + 3 <= 3·MAX_DEPTH` after it has pushed.
+const STACK: usize = 3 * MAX_DEPTH;
+
+/// A child to visit: `(child, count)` as in [`super::Node4`]'s slots (count 0: the node `child`;
+/// otherwise the leaf `prim_ids[child..child + count]`), and its entry distance.
+type Entry<S> = (u32, u32, S);
+
+/// Compare-exchange: `e[i]` before `e[j]` unless `e[j]` is strictly nearer.
+#[inline(always)]
+fn cmpx<S: Scalar>(e: &mut [Entry<S>; 4], i: usize, j: usize) {
+    let (a, b) = (e[i & 3], e[j & 3]);
+    if b.2 < a.2 {
+        e[i & 3] = b;
+        e[j & 3] = a;
+    }
+}
+
+/// Sorts the first `n` entries by entry distance (sorting networks for 2, 3 and 4).
+#[inline(always)]
+fn sort_nearest_first<S: Scalar>(e: &mut [Entry<S>; 4], n: usize) {
+    match n {
+        2 => cmpx(e, 0, 1),
+        3 => {
+            cmpx(e, 0, 1);
+            cmpx(e, 1, 2);
+            cmpx(e, 0, 1);
+        }
+        4 => {
+            cmpx(e, 0, 1);
+            cmpx(e, 2, 3);
+            cmpx(e, 0, 2);
+            cmpx(e, 1, 3);
+            cmpx(e, 1, 2);
+        }
+        _ => {}
+    }
+}
+
+impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
+    /// Walks the tree. With `ANY`, returns at the first hit in range; otherwise finds the
+    /// closest under [`closer`]. Returns (t, prim id, index into `prims`) of the hit;
+    /// `prim id == u32::MAX` for none.
+    #[inline(never)]
+    fn traverse<const ANY: bool, C: Counters>(
+        &self,
+        ray: &Ray<S>,
+        stats: &mut C,
+    ) -> (S, u32, usize) {
+        let rd = ray.data();
+        let t_min = ray.t_min();
+        let mut best_t = ray.t_max();
+        let mut best_prim = u32::MAX;
+        let mut best_at = 0usize;
+        if self.nodes.is_empty() {
+            return (best_t, best_prim, best_at);
+        }
+        // Cannot overflow (see `STACK`); a failed push would only skip a child.
+        let mut stack: heapless::Vec<Entry<S>, STACK> = heapless::Vec::new();
+        // The root's own box is not stored: its children's boxes are tested instead.
+        let (mut child, mut count) = (0u32, 0u32);
+        'walk: loop {
+            if count == 0 {
+                if let Some(node) = self.nodes.get(child as usize) {
+                    let used = node.used_mask();
+                    for _ in 0..used.count_ones() {
+                        stats.node();
+                    }
+                    let (hit, t) = S::slab4(rd, &node.lo, &node.hi, t_min, best_t);
+                    let hit = hit & used;
+                    if hit != 0 {
+                        let i = hit.trailing_zeros() as usize & 3;
+                        let others = hit & (hit - 1);
+                        if others == 0 {
+                            // One child hit (the common case deep in the tree): go there.
+                            (child, count) = (node.child[i], node.count[i]);
+                            continue 'walk;
+                        }
+                        let j = others.trailing_zeros() as usize & 3;
+                        if others & (others - 1) == 0 {
+                            // Two: visit the nearer (the first on a tie), push the other.
+                            let (a, b) = (
+                                (node.child[i], node.count[i], t[i]),
+                                (node.child[j], node.count[j], t[j]),
+                            );
+                            let (near, far) = if b.2 < a.2 { (b, a) } else { (a, b) };
+                            let _ = stack.push(far);
+                            (child, count) = (near.0, near.1);
+                            continue 'walk;
+                        }
+                    }
+                    // Hit children, compacted, then nearest first.
+                    let mut e: [Entry<S>; 4] = [(0, 0, t_min); 4];
+                    let mut n = 0usize;
+                    let mut rest = hit;
+                    while rest != 0 {
+                        let i = rest.trailing_zeros() as usize & 3;
+                        rest &= rest - 1;
+                        e[n & 3] = (node.child[i], node.count[i], t[i]);
+                        n += 1;
+                    }
+                    sort_nearest_first(&mut e, n);
+                    if let Some((&(c, k, _), rest)) = e.get(..n).and_then(<[_]>::split_first) {
+                        for &far in rest.iter().rev() {
+                            let _ = stack.push(far);
+                        }
+                        (child, count) = (c, k);
+                        continue 'walk;
+                    }
+                }
+            } else {
+                let first = child as usize;
+                let ids = self
+                    .prim_ids
+                    .get(first..first + count as usize)
+                    .unwrap_or_default();
+                for (slot, &id) in (first..).zip(ids) {
+                    let at = if self.leaf_order { slot } else { id as usize };
+                    let Some(prim) = self.prims.get(at) else {
+                        continue;
+                    };
+                    stats.prim();
+                    if let Some(t) = prim.hit_t(rd, t_min, best_t) {
+                        if ANY {
+                            return (t, id, at);
+                        }
+                        if closer(t, id, best_t, best_prim) {
+                            best_t = t;
+                            best_prim = id;
+                            best_at = at;
+                        }
+                    }
+                }
+            }
+            // Pop the next child still in reach of the current best.
+            loop {
+                let Some((c, k, t_near)) = stack.pop() else {
+                    break 'walk;
+                };
+                if t_near <= S::widen(best_t) {
+                    (child, count) = (c, k);
+                    continue 'walk;
+                }
+            }
+        }
+        (best_t, best_prim, best_at)
+    }
+}
+
+impl<S: Scalar, P: Primitive<S>> Accel<S> for Bvh4<'_, S, P> {
+    #[inline]
+    fn nearest_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Nearest<S>> {
+        let (t, prim, slot) = self.traverse::<false, C>(ray, stats);
+        Nearest::found(t, prim, slot)
+    }
+
+    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
+        found.barycentrics_in(self.prims, ray)
+    }
+
+    #[inline]
+    fn occluded_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> bool {
+        self.traverse::<true, C>(ray, stats).1 != u32::MAX
+    }
+}

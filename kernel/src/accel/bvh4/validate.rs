@@ -1,0 +1,123 @@
+//! Structural checker for a collapsed tree, called by tests after every collapse.
+
+use super::node::EMPTY_SLOT;
+use super::Bvh4;
+use crate::accel::bvh::{check_permutation, InvalidTree, TreeStats, MAX_DEPTH, MAX_LEAF_SIZE};
+use crate::geom::Primitive;
+use crate::scalar::Scalar;
+
+/// Depth-first work list capacity: `3·MAX_DEPTH` pending children (the traversal bound, see
+/// `traverse.rs`) plus the 4 a node pushes.
+const STACK: usize = 3 * MAX_DEPTH + 4;
+
+impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
+    /// Checks every invariant: used slots first and at least two per node (one only for a
+    /// root over a single leaf), inner children after their parent and inside its slot box,
+    /// every node reached exactly once, leaves tiling the id slice in depth-first order, every
+    /// primitive exactly once and inside its leaf's box, wide depth below [`MAX_DEPTH`] and as
+    /// recorded. `TreeStats::depth` is the depth of the deepest wide node.
+    ///
+    /// # Errors
+    /// The first violation found.
+    pub fn validate(&self) -> Result<TreeStats, InvalidTree> {
+        let n = self.prims.len();
+        let mut stats = TreeStats {
+            node_count: self.nodes.len(),
+            ..TreeStats::default()
+        };
+        if n == 0 || self.nodes.is_empty() {
+            return if n == 0 && self.nodes.is_empty() {
+                Ok(stats)
+            } else {
+                Err(InvalidTree::BadLeafRange { node: 0 })
+            };
+        }
+        // (child, count, depth): count 0 is the node `child`, otherwise a leaf.
+        let mut stack = [(0u32, 0u32, 0u32); STACK];
+        let mut sp = 1usize;
+        let (mut next_first, mut visited) = (0usize, 0usize);
+        while sp > 0 {
+            sp -= 1;
+            let Some(&(child, count, depth)) = stack.get(sp) else {
+                return Err(InvalidTree::TooDeep { depth: sp });
+            };
+            if count > 0 {
+                // A leaf, reached in depth-first order: its range continues the previous one.
+                let (first, count) = (child as usize, count as usize);
+                if first != next_first || count > MAX_LEAF_SIZE as usize || first + count > n {
+                    return Err(InvalidTree::BadLeafRange { node: first });
+                }
+                next_first = first + count;
+                continue;
+            }
+            let index = child as usize;
+            let depth = depth as usize;
+            if depth >= MAX_DEPTH {
+                return Err(InvalidTree::TooDeep { depth });
+            }
+            stats.depth = stats.depth.max(depth);
+            visited += 1;
+            let Some(node) = self.nodes.get(index) else {
+                return Err(InvalidTree::BadChild { node: index });
+            };
+            let used = node.child_count();
+            let single_leaf_root = index == 0 && used == 1 && node.count[0] > 0;
+            if node.used_mask() != (1 << used) - 1 || (used < 2 && !single_leaf_root) {
+                return Err(InvalidTree::BadChild { node: index });
+            }
+            // Push in reverse so slot 0 is visited first.
+            for slot in (0..used).rev() {
+                let (Some(b), Some((c, k))) = (node.bounds(slot), node.slot(slot)) else {
+                    return Err(InvalidTree::BadChild { node: index });
+                };
+                if k == 0 {
+                    let ci = c as usize;
+                    let Some(kid) = self.nodes.get(ci).filter(|_| ci > index) else {
+                        return Err(InvalidTree::BadChild { node: index });
+                    };
+                    for s in 0..kid.child_count() {
+                        if !kid.bounds(s).is_some_and(|kb| b.contains(&kb)) {
+                            return Err(InvalidTree::ChildOutsideParent { node: ci });
+                        }
+                    }
+                } else if k != EMPTY_SLOT {
+                    stats.leaf_count += 1;
+                    stats.max_leaf_size = stats.max_leaf_size.max(k);
+                    let first = c as usize;
+                    let Some(ids) = self.prim_ids.get(first..first.saturating_add(k as usize))
+                    else {
+                        return Err(InvalidTree::BadLeafRange { node: index });
+                    };
+                    for (at_slot, &id) in (first..).zip(ids) {
+                        let at = if self.leaf_order {
+                            at_slot
+                        } else {
+                            id as usize
+                        };
+                        let Some(p) = self.prims.get(at) else {
+                            return Err(InvalidTree::BadPrimIds { prim: id });
+                        };
+                        if !b.contains(&p.bounds()) {
+                            return Err(InvalidTree::PrimOutsideLeaf {
+                                node: index,
+                                prim: id,
+                            });
+                        }
+                    }
+                }
+                let Some(top) = stack.get_mut(sp) else {
+                    return Err(InvalidTree::TooDeep { depth: depth + 1 });
+                };
+                *top = (c, k, depth as u32 + 1);
+                sp += 1;
+            }
+        }
+        if next_first != n || visited != self.nodes.len() {
+            return Err(InvalidTree::BadLeafRange { node: 0 });
+        }
+        if stats.depth != self.depth as usize {
+            return Err(InvalidTree::TooDeep { depth: stats.depth });
+        }
+        check_permutation(self.prim_ids).map(|()| stats)
+    }
+}
