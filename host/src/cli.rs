@@ -446,11 +446,12 @@ pub struct TraceReport {
     pub hits: usize,
     /// Rays the kernel rejected, written as misses.
     pub bad_rays: usize,
-    /// BVH nodes (0 for linear).
+    /// BVH nodes (bvh4: 4-wide nodes; 0 for linear).
     pub nodes: usize,
-    /// Bytes of BVH nodes and primitive ids per triangle (0 for linear).
+    /// Bytes of BVH nodes and primitive ids per triangle (bvh4: its 4-wide nodes and the ids;
+    /// the BVH it is collapsed from is build scratch, not counted; 0 for linear).
     pub bytes_per_tri: f64,
-    /// BVH depth (0 for linear).
+    /// BVH depth (bvh4: depth of the deepest 4-wide node; 0 for linear).
     pub depth: u32,
 }
 

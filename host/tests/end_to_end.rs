@@ -243,6 +243,36 @@ fn leaf_order_writes_the_same_hit_files() {
     }
 }
 
+/// The 4-wide BVH writes the bytes brute force writes, for every builder and leaf size, in id
+/// order and in leaf order, and counts only its own nodes and the ids.
+#[test]
+fn bvh4_matches_brute_force_byte_for_byte() {
+    let s = scene("end_to_end_bvh4");
+    for mode in [Mode::F32, Mode::Fixed] {
+        let (_, reference) = run(&args(&s, AccelKind::Linear, Builder::Sah, mode, 4));
+        for builder in [Builder::Sah, Builder::Median, Builder::Midpoint] {
+            for leaf in [1, 4, 16] {
+                for leaf_order in [false, true] {
+                    let mut a = args(&s, AccelKind::Bvh4, builder, mode, leaf);
+                    a.leaf_order = leaf_order;
+                    a.out = s.dir.join(format!(
+                        "bvh4.{builder:?}.{mode:?}.{leaf}.{leaf_order}.hits"
+                    ));
+                    let (report, bytes) = run(&a);
+                    assert!(
+                        bytes == reference,
+                        "{mode:?} {builder:?} leaf {leaf} leaf order {leaf_order}: bvh4 differs"
+                    );
+                    assert_eq!(report.accel, "bvh4");
+                    let expected = (report.nodes * 128 + report.triangles * 4) as f64;
+                    let got = report.bytes_per_tri * report.triangles as f64;
+                    assert!((got - expected).abs() <= 1e-9 * expected, "{report:?}");
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn several_runs_report_medians_and_write_the_same_hits() {
     let s = scene("end_to_end_runs");

@@ -105,7 +105,7 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                             continue 'walk;
                         }
                     }
-                    // Hit children, compacted, then nearest first.
+                    // None, three or four: the hit children compacted, then nearest first.
                     let mut e: [Entry<S>; 4] = [(0, 0, t_min); 4];
                     let mut n = 0usize;
                     let mut rest = hit;
@@ -128,7 +128,7 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                 let first = child as usize;
                 let ids = self
                     .prim_ids
-                    .get(first..first + count as usize)
+                    .get(first..first.saturating_add(count as usize))
                     .unwrap_or_default();
                 for (slot, &id) in (first..).zip(ids) {
                     let at = if self.leaf_order { slot } else { id as usize };
