@@ -47,13 +47,15 @@ fn open<S: Scalar>(src: &[Node<S>], parent: &Node<S>) -> ([u32; 4], usize) {
             break;
         };
         // kids[j + 1..k] move one slot right; kids[j], kids[j + 1] become the two children.
-        if let Some(tail) = kids.get_mut(j..=k) {
-            tail.rotate_right(1);
-            if let [a, b, ..] = tail {
-                *a = first;
-                *b = first.wrapping_add(1);
-            }
+        // (Indices are below 4 here: j < k <= 3; the masks only show the compiler, as
+        // `rotate_right` kept a panic path for an empty slice.)
+        let mut m = k;
+        while m > j + 1 {
+            kids[m & 3] = kids[(m - 1) & 3];
+            m -= 1;
         }
+        kids[j & 3] = first;
+        kids[(j + 1) & 3] = first.wrapping_add(1);
         k += 1;
     }
     (kids, k)
