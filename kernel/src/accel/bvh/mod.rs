@@ -20,6 +20,7 @@ mod traverse;
 mod validate;
 
 pub use node::Node;
+pub(crate) use traverse::{test_leaf, LeafPrims};
 pub(crate) use validate::check_permutation;
 pub use validate::{InvalidTree, TreeStats};
 

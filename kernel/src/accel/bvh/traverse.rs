@@ -20,15 +20,14 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
     ) -> (S, u32, usize) {
         let rd = ray.data();
         let t_min = ray.t_min();
-        let mut best_t = ray.t_max();
-        let mut best_prim = u32::MAX;
-        let mut best_at = 0usize;
+        // (t, prim id, index into `prims`) of the best hit so far.
+        let mut best = (ray.t_max(), u32::MAX, 0usize);
         let Some(root) = self.nodes.first() else {
-            return (best_t, best_prim, best_at);
+            return best;
         };
         stats.node();
-        if S::slab(rd, &root.lo, &root.hi, t_min, best_t).is_none() {
-            return (best_t, best_prim, best_at);
+        if S::slab(rd, &root.lo, &root.hi, t_min, best.0).is_none() {
+            return best;
         }
         // Each level below the root pushes at most one entry, and leaves are at most
         // MAX_DEPTH deep, so the stack cannot overflow. `heapless::Vec` leaves its storage
@@ -37,34 +36,16 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
         let mut node: &Node<S> = root;
         'walk: loop {
             if node.count > 0 {
-                let first = node.first as usize;
-                let ids = self
-                    .prim_ids
-                    .get(first..first + node.count as usize)
-                    .unwrap_or_default();
-                for (slot, &id) in (first..).zip(ids) {
-                    let at = if self.leaf_order { slot } else { id as usize };
-                    let Some(prim) = self.prims.get(at) else {
-                        continue;
-                    };
-                    stats.prim();
-                    if let Some(t) = prim.hit_t(rd, t_min, best_t) {
-                        if ANY {
-                            return (t, id, at);
-                        }
-                        if closer(t, id, best_t, best_prim) {
-                            best_t = t;
-                            best_prim = id;
-                            best_at = at;
-                        }
-                    }
+                let leaf = (node.first as usize, node.count as usize);
+                if test_leaf::<ANY, S, P, C>(self.leaf(), leaf, rd, t_min, &mut best, stats) {
+                    return best;
                 }
             } else {
                 let l = node.first as usize;
                 if let Some([a, b]) = self.nodes.get(l..l + 2) {
                     stats.node();
                     stats.node();
-                    let [ta, tb] = S::slab_pair(rd, (&a.lo, &a.hi), (&b.lo, &b.hi), t_min, best_t);
+                    let [ta, tb] = S::slab_pair(rd, (&a.lo, &a.hi), (&b.lo, &b.hi), t_min, best.0);
                     match (ta, tb) {
                         (Some(ta), Some(tb)) => {
                             let (near, far, t_far) =
@@ -91,7 +72,7 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                 let Some((index, t_near)) = stack.pop() else {
                     break 'walk;
                 };
-                if t_near <= S::widen(best_t) {
+                if t_near <= S::widen(best.0) {
                     if let Some(n) = self.nodes.get(index as usize) {
                         node = n;
                         continue 'walk;
@@ -99,8 +80,51 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                 }
             }
         }
-        (best_t, best_prim, best_at)
+        best
     }
+
+    /// What [`test_leaf`] reads: the primitive ids, the primitives, and whether they are in
+    /// leaf order.
+    #[inline(always)]
+    fn leaf(&self) -> LeafPrims<'_, P> {
+        (self.prim_ids, self.prims, self.leaf_order)
+    }
+}
+
+/// A BVH's primitive ids, its primitives, and whether `prims[i]` is the primitive with id
+/// `prim_ids[i]` (leaf order) rather than the one with id `i`.
+pub(crate) type LeafPrims<'a, P> = (&'a [u32], &'a [P], bool);
+
+/// The leaf loop of both BVH traversals (binary and 4-wide): tests the primitives with the ids
+/// `prim_ids[first..first + count]`, keeping in `best` (t, prim id, index into `prims`) the
+/// closest hit under [`closer`]. With `ANY`, stores the first hit in range and returns true.
+#[inline(always)]
+pub(crate) fn test_leaf<const ANY: bool, S: Scalar, P: Primitive<S>, C: Counters>(
+    (prim_ids, prims, leaf_order): LeafPrims<'_, P>,
+    (first, count): (usize, usize),
+    rd: &S::RayData,
+    t_min: S,
+    best: &mut (S, u32, usize),
+    stats: &mut C,
+) -> bool {
+    let ids = prim_ids.get(first..first + count).unwrap_or_default();
+    for (slot, &id) in (first..).zip(ids) {
+        let at = if leaf_order { slot } else { id as usize };
+        let Some(prim) = prims.get(at) else {
+            continue;
+        };
+        stats.prim();
+        if let Some(t) = prim.hit_t(rd, t_min, best.0) {
+            if ANY {
+                *best = (t, id, at);
+                return true;
+            }
+            if closer(t, id, best.0, best.1) {
+                *best = (t, id, at);
+            }
+        }
+    }
+    false
 }
 
 impl<S: Scalar, P: Primitive<S>> Accel<S> for Bvh<'_, S, P> {

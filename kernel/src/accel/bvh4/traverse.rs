@@ -2,9 +2,9 @@
 //! hit and any hit.
 
 use super::Bvh4;
-use crate::accel::bvh::MAX_DEPTH;
+use crate::accel::bvh::{test_leaf, LeafPrims, MAX_DEPTH};
 use crate::accel::{Accel, Counters, Nearest};
-use crate::geom::{closer, Primitive, Ray};
+use crate::geom::{Primitive, Ray};
 use crate::scalar::Scalar;
 
 /// Traversal stack capacity.
@@ -65,11 +65,10 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
     ) -> (S, u32, usize) {
         let rd = ray.data();
         let t_min = ray.t_min();
-        let mut best_t = ray.t_max();
-        let mut best_prim = u32::MAX;
-        let mut best_at = 0usize;
+        // (t, prim id, index into `prims`) of the best hit so far.
+        let mut best = (ray.t_max(), u32::MAX, 0usize);
         if self.nodes.is_empty() {
-            return (best_t, best_prim, best_at);
+            return best;
         }
         // Cannot overflow (see `STACK`); a failed push would only skip a child.
         let mut stack: heapless::Vec<Entry<S>, STACK> = heapless::Vec::new();
@@ -82,7 +81,7 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                     for _ in 0..used.count_ones() {
                         stats.node();
                     }
-                    let (hit, t) = S::slab4(rd, &node.lo, &node.hi, t_min, best_t);
+                    let (hit, t) = S::slab4(rd, &node.lo, &node.hi, t_min, best.0);
                     let hit = hit & used;
                     if hit != 0 {
                         let i = hit.trailing_zeros() as usize & 3;
@@ -125,27 +124,9 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                     }
                 }
             } else {
-                let first = child as usize;
-                let ids = self
-                    .prim_ids
-                    .get(first..first.saturating_add(count as usize))
-                    .unwrap_or_default();
-                for (slot, &id) in (first..).zip(ids) {
-                    let at = if self.leaf_order { slot } else { id as usize };
-                    let Some(prim) = self.prims.get(at) else {
-                        continue;
-                    };
-                    stats.prim();
-                    if let Some(t) = prim.hit_t(rd, t_min, best_t) {
-                        if ANY {
-                            return (t, id, at);
-                        }
-                        if closer(t, id, best_t, best_prim) {
-                            best_t = t;
-                            best_prim = id;
-                            best_at = at;
-                        }
-                    }
+                let leaf = (child as usize, count as usize);
+                if test_leaf::<ANY, S, P, C>(self.leaf(), leaf, rd, t_min, &mut best, stats) {
+                    return best;
                 }
             }
             // Pop the next child still in reach of the current best.
@@ -153,13 +134,19 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                 let Some((c, k, t_near)) = stack.pop() else {
                     break 'walk;
                 };
-                if t_near <= S::widen(best_t) {
+                if t_near <= S::widen(best.0) {
                     (child, count) = (c, k);
                     continue 'walk;
                 }
             }
         }
-        (best_t, best_prim, best_at)
+        best
+    }
+
+    /// What [`test_leaf`] reads (see `Bvh::leaf`).
+    #[inline(always)]
+    fn leaf(&self) -> LeafPrims<'_, P> {
+        (self.prim_ids, self.prims, self.leaf_order)
     }
 }
 
