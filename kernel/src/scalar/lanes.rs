@@ -84,6 +84,11 @@ mod sse {
         pub(crate) fn le_mask(self, o: Self) -> u32 {
             unsafe { _mm_movemask_ps(_mm_cmple_ps(self.0, o.0)) as u32 }
         }
+        /// Bit `i` set if lane `i`'s sign bit is set.
+        #[inline(always)]
+        pub(crate) fn sign_mask(self) -> u32 {
+            unsafe { _mm_movemask_ps(self.0) as u32 }
+        }
         #[inline(always)]
         pub(crate) fn lane0(self) -> f32 {
             unsafe { _mm_cvtss_f32(self.0) }
@@ -158,6 +163,10 @@ mod portable {
             (0..4).fold(0, |m, i| m | (u32::from(self.0[i] <= o.0[i]) << i))
         }
         #[inline(always)]
+        pub(crate) fn sign_mask(self) -> u32 {
+            (0..4).fold(0, |m, i| m | ((self.0[i].to_bits() >> 31) << i))
+        }
+        #[inline(always)]
         pub(crate) fn lane0(self) -> f32 {
             self.0[0]
         }
@@ -227,6 +236,7 @@ mod tests {
             same(pa.unpack_lo(pb), sa.unpack_lo(sb), "unpack_lo");
             same(pa.unpack_hi(pb), sa.unpack_hi(sb), "unpack_hi");
             same(pa.high_half(), sa.high_half(), "high_half");
+            assert_eq!(pa.sign_mask(), sa.sign_mask(), "sign_mask {a:?}");
             same(P::splat(a[0]), S::splat(a[0]), "splat");
             assert_eq!(pa.le_mask(pb), sa.le_mask(sb), "le_mask {a:?} {b:?}");
         }

@@ -7,7 +7,7 @@
 
 mod fixed;
 mod float;
-mod lanes;
+pub(crate) mod lanes;
 mod wide;
 
 pub use fixed::{FixedRay, Vec3x, FIXED_COORD_LIMIT, I16F16};

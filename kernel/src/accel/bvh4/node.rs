@@ -1,4 +1,5 @@
 use crate::geom::Aabb;
+use crate::scalar::lanes::F4;
 use crate::scalar::Scalar;
 
 /// `count` of an unused child slot.
@@ -47,14 +48,12 @@ impl<S: Scalar> Node4<S> {
         count: [EMPTY_SLOT; 4],
     };
 
-    /// Bit `i` set if slot `i` is used.
+    /// Bit `i` set if slot `i` is used: the sign bits of `count` (a used slot's count is at
+    /// most [`crate::bvh::MAX_LEAF_SIZE`], [`EMPTY_SLOT`] has its top bit set), inverted; one
+    /// vector move-mask where `F4` has SSE.
     #[inline(always)]
     pub(crate) fn used_mask(&self) -> u32 {
-        let [a, b, c, d] = self.count;
-        u32::from(a != EMPTY_SLOT)
-            | u32::from(b != EMPTY_SLOT) << 1
-            | u32::from(c != EMPTY_SLOT) << 2
-            | u32::from(d != EMPTY_SLOT) << 3
+        !F4::new(self.count.map(f32::from_bits)).sign_mask() & 0b1111
     }
 
     /// Sets slot `i` (0..4; others are ignored).

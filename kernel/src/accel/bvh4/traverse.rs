@@ -83,6 +83,7 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                     }
                     let (hit, t) = S::slab4(rd, &node.lo, &node.hi, t_min, best.0);
                     let hit = hit & used;
+                    // None hit: fall through to the pop below.
                     if hit != 0 {
                         let i = hit.trailing_zeros() as usize & 3;
                         let others = hit & (hit - 1);
@@ -103,24 +104,24 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                             (child, count) = (near.0, near.1);
                             continue 'walk;
                         }
-                    }
-                    // None, three or four: the hit children compacted, then nearest first.
-                    let mut e: [Entry<S>; 4] = [(0, 0, t_min); 4];
-                    let mut n = 0usize;
-                    let mut rest = hit;
-                    while rest != 0 {
-                        let i = rest.trailing_zeros() as usize & 3;
-                        rest &= rest - 1;
-                        e[n & 3] = (node.child[i], node.count[i], t[i]);
-                        n += 1;
-                    }
-                    sort_nearest_first(&mut e, n);
-                    if let Some((&(c, k, _), rest)) = e.get(..n).and_then(<[_]>::split_first) {
-                        for &far in rest.iter().rev() {
-                            let _ = stack.push(far);
+                        // Three or four: the hit children compacted, then nearest first.
+                        let mut e: [Entry<S>; 4] = [(0, 0, t_min); 4];
+                        let mut n = 0usize;
+                        let mut rest = hit;
+                        while rest != 0 {
+                            let i = rest.trailing_zeros() as usize & 3;
+                            rest &= rest - 1;
+                            e[n & 3] = (node.child[i], node.count[i], t[i]);
+                            n += 1;
                         }
-                        (child, count) = (c, k);
-                        continue 'walk;
+                        sort_nearest_first(&mut e, n);
+                        if let Some((&(c, k, _), rest)) = e.get(..n).and_then(<[_]>::split_first) {
+                            for &far in rest.iter().rev() {
+                                let _ = stack.push(far);
+                            }
+                            (child, count) = (c, k);
+                            continue 'walk;
+                        }
                     }
                 }
             } else {
