@@ -18,7 +18,7 @@ use crate::spec::{SceneOrigin, SceneSpec};
 use crate::trace::{trace, AccelKind, Builder, Mode, TraceConfig};
 use clap::builder::RangedU64ValueParser;
 use clap::{Args, Parser, Subcommand};
-use raykernel::bvh::{BuildOptions, BuilderKind, MAX_LEAF_SIZE};
+use raykernel::bvh::{BuildOptions, BuilderKind, DEFAULT_LEAF_SIZE, MAX_LEAF_SIZE};
 use raykernel::render::{scenes, Settings};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -130,7 +130,7 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value_t = Builder::Sah)]
     pub builder: Builder,
     /// Largest BVH leaf (1..=64).
-    #[arg(long, default_value_t = 4,
+    #[arg(long, default_value_t = DEFAULT_LEAF_SIZE,
           value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_LEAF_SIZE)))]
     pub leaf: u32,
     /// Skip the BVH's reinsertion pass (keep the tree exactly as the builder split it).
@@ -278,7 +278,7 @@ pub struct TraceArgs {
     #[arg(long, value_enum, default_value_t = Mode::F32)]
     pub mode: Mode,
     /// Largest BVH leaf (1..=64).
-    #[arg(long, default_value_t = 4,
+    #[arg(long, default_value_t = DEFAULT_LEAF_SIZE,
           value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_LEAF_SIZE)))]
     pub leaf: u32,
     /// Skip the BVH's reinsertion pass (keep the tree exactly as the builder split it).

@@ -35,6 +35,10 @@ pub const MAX_DEPTH: usize = 64;
 pub const MEDIAN_FALLBACK_DEPTH: usize = MAX_DEPTH - 32;
 /// Largest accepted `max_leaf_size`.
 pub const MAX_LEAF_SIZE: u32 = 64;
+/// The default `max_leaf_size`. Measured against 4 (cachegrind, SAH, both tree widths): 3 runs
+/// 6–8% fewer traversal instructions on the shared kitchen scene's primary and incoherent rays,
+/// 1–3% fewer on sponza's, and builds the same tree on the bunny.
+pub const DEFAULT_LEAF_SIZE: u32 = 3;
 
 /// Exact node slots [`Bvh::build`] needs for `prim_count` primitives in the worst case:
 /// `2n` for `n >= 2` (a binary tree with one primitive per leaf has `2n - 1` nodes, and slot 1
@@ -111,7 +115,7 @@ impl Default for BuildOptions {
     fn default() -> Self {
         Self {
             builder: BuilderKind::Sah,
-            max_leaf_size: 4,
+            max_leaf_size: DEFAULT_LEAF_SIZE,
             reinsertion: true,
         }
     }
