@@ -34,15 +34,21 @@ pub enum AccelKind {
     Grid,
     /// The kernel's kd-tree (SAH, automatic depth).
     Kdtree,
-    /// The kernel's 4-wide BVH, collapsed from the BVH (same builder options). Trace only:
-    /// the renderer has no 4-wide BVH, and the benchmark does not run it yet.
+    /// The kernel's 4-wide BVH, collapsed from the BVH (same builder options). Trace and
+    /// benchmark only: the renderer has no 4-wide BVH.
     Bvh4,
 }
 
 impl AccelKind {
-    /// Every accelerator the benchmark compares, in command-line order (not
-    /// [`AccelKind::Bvh4`], which `host trace` alone offers so far).
-    pub const ALL: [AccelKind; 4] = [Self::Bvh, Self::Linear, Self::Grid, Self::Kdtree];
+    /// Every accelerator the benchmark compares. The first is the benchmark's reference for
+    /// the peers: the fastest (the 4-wide BVH).
+    pub const ALL: [AccelKind; 5] = [
+        Self::Bvh4,
+        Self::Bvh,
+        Self::Linear,
+        Self::Grid,
+        Self::Kdtree,
+    ];
 
     /// True for brute force, the reference: too slow for whole benchmark ray sets.
     #[must_use]

@@ -84,6 +84,8 @@ fn bench_writes_a_well_formed_report_csv_json_and_plots() {
         assert!(report.contains(section), "missing {section}");
     }
     for contender in [
+        "raykernel bvh4 sah f32",
+        "raykernel bvh4 sah fixed",
         "raykernel bvh sah f32",
         "raykernel bvh sah fixed",
         "raykernel bvh sah f32 MT",
@@ -139,12 +141,12 @@ fn bench_writes_a_well_formed_report_csv_json_and_plots() {
         assert!(sections.contains(s), "no {s} figures in the CSV");
     }
 
-    // JSON: 2 scenes × 2 ray sets × (11 of ours: BVH 3 builders × 2 modes + Möller–Trumbore,
-    // grid and kd-tree × 2 modes; + 3 peers).
+    // JSON: 2 scenes × 2 ray sets × (17 of ours: 4-wide BVH and BVH 3 builders × 2 modes each,
+    // Möller–Trumbore, grid and kd-tree × 2 modes; + 3 peers).
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("data.json")).unwrap()).unwrap();
     let rows = json["rows"].as_array().unwrap();
-    assert_eq!(rows.len(), 2 * 2 * (11 + 3));
+    assert_eq!(rows.len(), 2 * 2 * (17 + 3));
     for row in rows {
         // A closed sphere seen from outside: every contender finds the same hits as ours,
         // and no contender leaks or invents hits against the f64 reference.
