@@ -522,10 +522,14 @@ fn ours_section(s: &mut String, r: &BenchResults) {
     );
     let _ = writeln!(
         s,
-        "Leaves of up to 4 primitives. `any hit` is `occluded` (first hit in range), timed once on the last run. Nodes \
-         and primitives are counted per closest-hit ray. Bytes per triangle count the nodes \
-         in use and the primitive ids (not the triangles). `MT` is the benchmark-only \
-         Möller–Trumbore test on the same tree (a contrast, not part of the kernel).\n"
+        "BVH leaves of up to {} primitives (`bvh::DEFAULT_LEAF_SIZE`); `bvh4` is the 4-wide BVH \
+         collapsed from the BVH of the same builder. `any hit` is `occluded` (first hit in \
+         range), timed once on the last run. Nodes and primitives are counted per closest-hit \
+         ray (for `bvh4`, every child box tested counts as a node). Bytes per triangle count \
+         the nodes in use and the primitive ids (not the triangles). `MT` is the \
+         benchmark-only Möller–Trumbore test on the same tree (a contrast, not part of the \
+         kernel).\n",
+        raykernel::bvh::DEFAULT_LEAF_SIZE
     );
     let _ = writeln!(
         s,
