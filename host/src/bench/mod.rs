@@ -75,6 +75,17 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
     eprintln!("bench: {}", machine.line());
     let scenes = workload::load_scenes(&config.scenes_dir, &config.scenes, &config.rays)?;
     let threads = machine.cores.max(1);
+    // Warm-up, untimed: the reference configuration once on the first ray set. Without it the
+    // first figure of a run came out 10–20% below the same configuration measured later in
+    // the run (the machine settling: clocks, page faults of fresh allocations).
+    if let Some((scene, set)) = scenes.iter().find_map(|s| Some((s, s.ray_sets.first()?))) {
+        eprintln!(
+            "bench: warm-up ({} {}, untimed)",
+            scene.name,
+            set.kind.name()
+        );
+        ours::warm_up(scene, set, opts)?;
+    }
     let mut rows = Vec::new();
     let mut references = Vec::new();
     for scene in &scenes {

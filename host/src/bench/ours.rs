@@ -160,6 +160,20 @@ pub fn run(scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Result<Vec<Tra
     Ok(rows)
 }
 
+/// One untimed build and trace of the first configuration of [`configs`] (the reference), to
+/// let the machine settle before the first measured figure.
+///
+/// # Errors
+/// As [`run`].
+pub fn warm_up(scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Result<(), Error> {
+    let Some(config) = configs().into_iter().next() else {
+        return Ok(());
+    };
+    let tris32 = scene.mesh.kernel_triangles::<f32>(&scene.path)?;
+    let prepared = prepare_rays::<f32>(&set.records, opts.stride);
+    measure(&tris32, &prepared, &scene.path, &config.accel, 1).map(|_| ())
+}
+
 /// Million rays per second.
 #[must_use]
 pub fn mrays(rays: usize, ms: f64) -> f64 {

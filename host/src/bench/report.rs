@@ -381,7 +381,8 @@ pub fn markdown(r: &BenchResults) -> String {
     let _ = writeln!(
         s,
         "- workload: `shared/bench/WORKLOAD.md` scenes and ray sets ({}), {}, \
-         {} run{} (build + trace) per figure, medians; single thread{}",
+         {} run{} (build + trace) per figure, medians, after one untimed warm-up run of the \
+         first configuration; single thread{}",
         r.ray_source,
         if r.stride == 1 {
             "all rays".to_string()
