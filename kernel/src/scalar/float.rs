@@ -236,21 +236,21 @@ impl FloatRay {
     /// brute force would report.
     #[inline(always)]
     fn point_near_box(&self, t: f32, v: &[[f32; 3]; 3]) -> bool {
-        // Lanes x, y, z, z: each lane does the scalar operations of its axis (the fourth
-        // repeats z), so the bits are those of the per-axis scalar code on every target.
-        let xyzz = |p: &[f32; 3]| F4::new([p[0], p[1], p[2], p[2]]);
-        let [a, b, c] = v.each_ref().map(xyzz);
-        let (origin, dir) = (xyzz(&self.origin), xyzz(&self.dir));
-        // The largest magnitude among the origin's and the vertices' coordinates: a maximum
-        // of non-negative finite values, exact in any order.
-        let m = origin.abs().max(a.abs()).max(b.abs()).max(c.abs());
-        let m = m.max(m.high_half());
-        let m = m.lane0().max_of(m.lane1());
-        let e = F4::splat(m * (MARGIN * 0.5));
-        let p = origin.add(F4::splat(t).mul(dir));
-        let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
-        // `lo - e <= p <= hi + e` on every axis (false when unordered).
-        lo.sub(e).le_mask(p) & p.le_mask(hi.add(e)) == 0b1111
+        let mut m = abs(self.origin[0])
+            .max_of(abs(self.origin[1]))
+            .max_of(abs(self.origin[2]));
+        for p in v {
+            m = m.max_of(abs(p[0])).max_of(abs(p[1])).max_of(abs(p[2]));
+        }
+        let e = m * (MARGIN * 0.5);
+        let [a, b, c] = v;
+        (0..3).all(|i| {
+            let i = i.min(2); // a no-op that shows the compiler the bound
+            let p = self.origin[i] + t * self.dir[i];
+            let lo = a[i].min_of(b[i]).min_of(c[i]);
+            let hi = a[i].max_of(b[i]).max_of(c[i]);
+            p >= lo - e && p <= hi + e
+        })
     }
 
     /// Edge functions (U, V, W) of the sheared vertices, their sum `det`, and the scaled

@@ -15,9 +15,9 @@ mod sse {
     // transmute copies the 16 bytes of an `__m128` into a `[f32; 4]` of the same size, and
     // every bit pattern is a valid `f32`.
     use arch::{
-        __m128, _mm_add_ps, _mm_and_ps, _mm_castsi128_ps, _mm_cmple_ps, _mm_cvtss_f32, _mm_div_ps,
-        _mm_max_ps, _mm_min_ps, _mm_movehl_ps, _mm_movemask_ps, _mm_mul_ps, _mm_set1_epi32,
-        _mm_set1_ps, _mm_setr_ps, _mm_shuffle_ps, _mm_sub_ps, _mm_unpackhi_ps, _mm_unpacklo_ps,
+        __m128, _mm_cmple_ps, _mm_cvtss_f32, _mm_div_ps, _mm_max_ps, _mm_min_ps, _mm_movehl_ps,
+        _mm_movemask_ps, _mm_mul_ps, _mm_set1_ps, _mm_setr_ps, _mm_shuffle_ps, _mm_sub_ps,
+        _mm_unpackhi_ps, _mm_unpacklo_ps,
     };
     #[cfg(target_arch = "x86")]
     use core::arch::x86 as arch;
@@ -38,17 +38,8 @@ mod sse {
             Self(unsafe { _mm_set1_ps(x) })
         }
         #[inline(always)]
-        pub(crate) fn add(self, o: Self) -> Self {
-            Self(unsafe { _mm_add_ps(self.0, o.0) })
-        }
-        #[inline(always)]
         pub(crate) fn sub(self, o: Self) -> Self {
             Self(unsafe { _mm_sub_ps(self.0, o.0) })
-        }
-        /// Per lane the sign bit cleared (as `f32::abs`).
-        #[inline(always)]
-        pub(crate) fn abs(self) -> Self {
-            Self(unsafe { _mm_and_ps(self.0, _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff))) })
         }
         #[inline(always)]
         pub(crate) fn mul(self, o: Self) -> Self {
@@ -140,16 +131,8 @@ mod portable {
                 | u32::from(f(a3, b3)) << 3
         }
         #[inline(always)]
-        pub(crate) fn add(self, o: Self) -> Self {
-            self.zip(o, |a, b| a + b)
-        }
-        #[inline(always)]
         pub(crate) fn sub(self, o: Self) -> Self {
             self.zip(o, |a, b| a - b)
-        }
-        #[inline(always)]
-        pub(crate) fn abs(self) -> Self {
-            Self(self.0.map(|x| f32::from_bits(x.to_bits() & 0x7fff_ffff)))
         }
         #[inline(always)]
         pub(crate) fn mul(self, o: Self) -> Self {
@@ -251,13 +234,7 @@ mod tests {
                     "{what} {a:?} {b:?}"
                 );
             };
-            same(pa.add(pb), sa.add(sb), "add");
             same(pa.sub(pb), sa.sub(sb), "sub");
-            assert_eq!(
-                pa.abs().to_array().map(f32::to_bits),
-                sa.abs().to_array().map(f32::to_bits),
-                "abs {a:?}"
-            );
             same(pa.mul(pb), sa.mul(sb), "mul");
             same(pa.div(pb), sa.div(sb), "div");
             assert_eq!(
