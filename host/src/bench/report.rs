@@ -654,19 +654,19 @@ fn accelerators_section(s: &mut String, r: &BenchResults) {
 
 /// When each structure wins: the reading of the committed full run (docs/bench) and of
 /// docs/ACCELERATORS.md; the winners list above it is computed from the run at hand.
-const ACCELERATORS_VERDICT: &str = "**When each wins.** The 4-wide BVH collapsed from the \
-SAH BVH traces fastest on every scene and ray set, ahead of the SAH BVH it is collapsed from \
-(its build is that BVH's plus the collapse); the SAH BVH traces about 1.3–5× as fast as the \
-grid and 1.3–3× as fast as the kd-tree in the committed run. The two are the choice whenever one build serves more than a few tens of thousands of rays: any \
-rendered frame. The uniform grid builds fastest (a counting pass and a fill pass, no sorting) \
-and is the smallest structure on the compact, evenly tessellated bunny; where triangle density \
-is uneven (sponza, kitchen) many triangles crowd a few cells and it is the slowest tracer of \
-primary rays, though it still beats the median-split BVH on incoherent rays. It wins overall \
-only when a scene is rebuilt for few rays (dynamic geometry traced sparsely). The kd-tree \
-builds slowest (SAH over straddling references) and is the largest; it traces faster than the \
-grid on primary rays and beats the median-split BVH (and, on incoherent rays of sponza and \
-kitchen, the midpoint BVH), but never the SAH BVH: with this budgeted build it has no niche \
-here beyond being the lecture's other space partition.";
+const ACCELERATORS_VERDICT: &str = "**When each wins.** The BVHs are the choice whenever one \
+build serves more than a few tens of thousands of rays: any rendered frame. The 4-wide BVH \
+collapsed from the binary one mostly traces fastest, by the widest margin on incoherent rays (up \
+to 1.7×); on primary rays the two are close. A single figure on this machine varies by up to 30% \
+between runs (slow and fast spells), so the winners listed above can change from run to run. The \
+SAH BVH traces 1.7–13× as fast as the grid and 1.4–4.4× as fast as the kd-tree across runs. The \
+uniform grid builds fastest (a counting pass and a fill pass, no sorting) and is the smallest \
+structure; it is the slowest tracer, most of all on primary rays where triangle density is \
+uneven (sponza, kitchen: many triangles crowd a few cells). It wins overall only when a scene is \
+rebuilt for few rays (dynamic geometry traced sparsely). The kd-tree builds slowest (SAH over \
+straddling references) and is the largest; it traces faster than the grid everywhere but far \
+behind the SAH BVH: with this budgeted build it has no niche here beyond being the lecture's \
+other space partition.";
 
 fn peers_section(s: &mut String, r: &BenchResults) {
     let _ = writeln!(s, "## Peers: same triangles, same rays, same run\n");
@@ -858,8 +858,9 @@ fn scale_section(s: &mut String, r: &BenchResults) {
         s,
         "Copies of the benchmark meshes on a grid of 10×10 cells (make_tiled.py's recipe with \
          SplitMix64 instead of numpy's generator; the last instance cut to the exact count) \
-         plus a ground plane; SAH BVH, leaves of up to 4; {} rays per set (primary from the \
+         plus a ground plane; SAH BVH, leaves of up to {}; {} rays per set (primary from the \
          3/4 camera, incoherent in the scene box).\n",
+        raykernel::bvh::DEFAULT_LEAF_SIZE,
         r.scale.first().map_or(0, |x| x.ray_count)
     );
     let _ = writeln!(
