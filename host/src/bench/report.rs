@@ -656,10 +656,10 @@ fn accelerators_section(s: &mut String, r: &BenchResults) {
 /// docs/ACCELERATORS.md; the winners list above it is computed from the run at hand.
 const ACCELERATORS_VERDICT: &str = "**When each wins.** The BVHs are the choice whenever one \
 build serves more than a few tens of thousands of rays: any rendered frame. The 4-wide BVH \
-collapsed from the binary one mostly traces fastest, by the widest margin on incoherent rays (up \
-to 1.7×); on primary rays the two are close. A single figure on this machine varies by up to 30% \
+collapsed from the binary one mostly traces fastest, by the widest margin on incoherent rays; on \
+primary rays the two are close. A single figure on this machine varies by up to 30% \
 between runs (slow and fast spells), so the winners listed above can change from run to run. The \
-SAH BVH traces 1.7–13× as fast as the grid and 1.4–4.4× as fast as the kd-tree across runs. The \
+SAH BVH traces several times as fast as the grid and the kd-tree (the table above). The \
 uniform grid builds fastest (a counting pass and a fill pass, no sorting) and is the smallest \
 structure; it is the slowest tracer, most of all on primary rays where triangle density is \
 uneven (sponza, kitchen: many triangles crowd a few cells). It wins overall only when a scene is \

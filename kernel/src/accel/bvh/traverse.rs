@@ -107,7 +107,9 @@ pub(crate) fn test_leaf<const ANY: bool, S: Scalar, P: Primitive<S>, C: Counters
     best: &mut (S, u32, usize),
     stats: &mut C,
 ) -> bool {
-    let ids = prim_ids.get(first..first + count).unwrap_or_default();
+    let ids = prim_ids
+        .get(first..first.saturating_add(count))
+        .unwrap_or_default();
     for (slot, &id) in (first..).zip(ids) {
         let at = if leaf_order { slot } else { id as usize };
         let Some(prim) = prims.get(at) else {
