@@ -142,11 +142,15 @@ fn bench_writes_a_well_formed_report_csv_json_and_plots() {
     }
 
     // JSON: 2 scenes × 2 ray sets × (17 of ours: 4-wide BVH and BVH 3 builders × 2 modes each,
-    // Möller–Trumbore, grid and kd-tree × 2 modes; + 3 peers).
+    // Möller–Trumbore, grid and kd-tree × 2 modes; + the peers: 3, and tinybvh with the
+    // `tinybvh` feature).
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("data.json")).unwrap()).unwrap();
     let rows = json["rows"].as_array().unwrap();
-    assert_eq!(rows.len(), 2 * 2 * (17 + 3));
+    assert_eq!(
+        rows.len(),
+        2 * 2 * (17 + host::bench::peers::Peer::ALL.len())
+    );
     for row in rows {
         // A closed sphere seen from outside: every contender finds the same hits as ours,
         // and no contender leaks or invents hits against the f64 reference.

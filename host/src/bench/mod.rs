@@ -101,9 +101,9 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
             );
             let mut set_rows = ours::run(scene, set, opts)?;
             if config.peers {
-                for peer in peers::Peer::ALL {
+                for &peer in peers::Peer::ALL {
                     eprintln!("bench:   {}", peer.name());
-                    set_rows.push(peers::run(peer, scene, set, opts));
+                    set_rows.extend(peers::run(peer, scene, set, opts));
                 }
             }
             let reference = accuracy::Reference::compute(&tris, &set.records, stride, threads)

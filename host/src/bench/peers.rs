@@ -1,7 +1,8 @@
 //! Peers measured in the same run, on the same triangles and rays: `obvhs` 0.4 (BVH2 and
-//! CWBVH, its own two-sided Möller–Trumbore test) and `bvh` 0.13 (svenstaro; its triangle test
+//! CWBVH, its own two-sided Möller–Trumbore test), `bvh` 0.13 (svenstaro; its triangle test
 //! culls back faces, so it traces with this benchmark's two-sided Möller–Trumbore from
-//! [`super::mt`], as the workload's triangles are two-sided).
+//! [`super::mt`], as the workload's triangles are two-sided) and, with the `tinybvh` feature,
+//! tinybvh 1.6.8's scalar BVH2 (C++, through `tinybvh-rs`).
 //!
 //! Each peer is used as its documentation shows, single-threaded (no rayon features): build
 //! from the triangle list, then one query per ray. Times and figures follow our rows: build
@@ -28,11 +29,22 @@ pub enum Peer {
     ObvhsCwbvh,
     /// `bvh` (svenstaro): binned SAH BVH2.
     SvenstaroBvh,
+    /// tinybvh's BVH2 (`BVH::Build`, binned SAH) and its scalar `BVH::Intersect`.
+    TinybvhBvh2,
 }
 
 impl Peer {
-    /// Every peer.
-    pub const ALL: [Peer; 3] = [Self::ObvhsBvh2, Self::ObvhsCwbvh, Self::SvenstaroBvh];
+    /// Every peer this build can run (tinybvh with the `tinybvh` feature only).
+    pub const ALL: &'static [Peer] = if cfg!(feature = "tinybvh") {
+        &[
+            Self::TinybvhBvh2,
+            Self::ObvhsBvh2,
+            Self::ObvhsCwbvh,
+            Self::SvenstaroBvh,
+        ]
+    } else {
+        &[Self::ObvhsBvh2, Self::ObvhsCwbvh, Self::SvenstaroBvh]
+    };
 
     /// Name in the report.
     #[must_use]
@@ -41,13 +53,14 @@ impl Peer {
             Self::ObvhsBvh2 => "obvhs 0.4 BVH2",
             Self::ObvhsCwbvh => "obvhs 0.4 CWBVH",
             Self::SvenstaroBvh => "bvh 0.13",
+            Self::TinybvhBvh2 => "tinybvh 1.6 BVH2",
         }
     }
 
     fn builder(self) -> &'static str {
         match self {
             Self::ObvhsBvh2 | Self::ObvhsCwbvh => "PLOC medium",
-            Self::SvenstaroBvh => "binned SAH",
+            Self::SvenstaroBvh | Self::TinybvhBvh2 => "binned SAH",
         }
     }
 
@@ -55,6 +68,7 @@ impl Peer {
         match self {
             Self::ObvhsBvh2 | Self::ObvhsCwbvh => "Möller–Trumbore (obvhs)",
             Self::SvenstaroBvh => "Möller–Trumbore (bench)",
+            Self::TinybvhBvh2 => "Möller–Trumbore (tinybvh)",
         }
     }
 }
@@ -67,13 +81,14 @@ struct PeerMeasured {
     any_ms: f64,
     hits: Vec<HitRecord>,
     any_hits: usize,
-    prims_tested: u64,
+    /// Primitive tests over all rays, where the peer lets us count them.
+    prims_tested: Option<u64>,
     bytes: usize,
 }
 
-/// Runs one peer on one ray set.
+/// Runs one peer on one ray set (`None`: a peer this build cannot run).
 #[must_use]
-pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> TraceRow {
+pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Option<TraceRow> {
     let tris: Vec<[[f32; 3]; 3]> = (0..scene.mesh.triangle_count())
         .map(|i| scene.mesh.triangle_f32(i))
         .collect();
@@ -82,9 +97,10 @@ pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Tr
     let m = match peer {
         Peer::ObvhsBvh2 | Peer::ObvhsCwbvh => obvhs_run(peer, &tris, &records, runs),
         Peer::SvenstaroBvh => svenstaro_run(&tris, &records, runs),
+        Peer::TinybvhBvh2 => tinybvh::run(&tris, &records, runs)?,
     };
     let n = m.hits.len();
-    TraceRow {
+    Some(TraceRow {
         scene: scene.name.clone(),
         rays: set.kind,
         ray_count: n,
@@ -99,11 +115,9 @@ pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Tr
         closest_mrays: mrays(n, m.closest_ms),
         any_mrays: mrays(n, m.any_ms),
         nodes_per_ray: None,
-        prims_per_ray: Some(if n > 0 {
-            m.prims_tested as f64 / n as f64
-        } else {
-            0.0
-        }),
+        prims_per_ray: m
+            .prims_tested
+            .map(|k| if n > 0 { k as f64 / n as f64 } else { 0.0 }),
         bytes_per_tri: if tris.is_empty() {
             0.0
         } else {
@@ -115,7 +129,7 @@ pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Tr
         vs_ours: None,
         accuracy: None,
         hit_records: m.hits,
-    }
+    })
 }
 
 /// The two obvhs structures share this query surface.
@@ -218,7 +232,7 @@ fn empty_measured() -> PeerMeasured {
         any_ms: 0.0,
         hits: Vec::new(),
         any_hits: 0,
-        prims_tested: 0,
+        prims_tested: None,
         bytes: 0,
     }
 }
@@ -275,7 +289,7 @@ fn obvhs_queries<B: ObvhsQueries>(
         any_ms: median(&any),
         hits,
         any_hits,
-        prims_tested: tested.get(),
+        prims_tested: Some(tested.get()),
         bytes: bvh.bytes(),
         ..empty_measured()
     };
@@ -425,7 +439,92 @@ fn svenstaro_run(
         any_ms: median(&any),
         hits,
         any_hits,
-        prims_tested: tested,
+        prims_tested: Some(tested),
         bytes: std::mem::size_of_val(&bvh.nodes[..]),
+    }
+}
+
+/// tinybvh through `tinybvh-rs`, with the `tinybvh` feature.
+#[cfg(feature = "tinybvh")]
+mod tinybvh {
+    use super::{empty_measured, PeerMeasured};
+    use crate::rayfile::{HitRecord, RayRecord};
+    use crate::trace::{median, millis};
+    use std::time::Instant;
+    use tinybvh_rs::{bvh::BVH, Intersector, Ray, INFINITE};
+
+    /// Builds `runs` times (`BVH::new`: tinybvh's default binned SAH build) and traces every
+    /// ray after each build with `BVH::Intersect`, its scalar BVH2 traversal. The workload's
+    /// rays start at `t_min = 0`, where tinybvh starts too; `t_max` is the ray's hit distance
+    /// on entry (tinybvh's "no hit" is 1e30). `tinybvh-rs` has no occlusion query: any hit is
+    /// not measured (0). Primitive tests are not counted either (tinybvh returns a cost, not
+    /// a count).
+    pub(super) fn run(
+        tris: &[[[f32; 3]; 3]],
+        records: &[&RayRecord],
+        runs: usize,
+    ) -> Option<PeerMeasured> {
+        // tinybvh reads vertices as four floats each, three per triangle.
+        let verts: Vec<[f32; 4]> = tris
+            .iter()
+            .flat_map(|t| t.map(|p| [p[0], p[1], p[2], 0.0]))
+            .collect();
+        let start = Instant::now();
+        let rays: Vec<Ray> = records
+            .iter()
+            .map(|r| {
+                let mut ray = Ray::new(r.origin, r.dir);
+                ray.hit.t = r.t_max.min(INFINITE);
+                ray
+            })
+            .collect();
+        let setup_ms = millis(start);
+        let mut builds = Vec::new();
+        let mut closest = Vec::new();
+        let mut hits = vec![HitRecord::MISS; rays.len()];
+        let mut bytes = 0;
+        for _ in 0..runs {
+            let start = Instant::now();
+            let bvh = BVH::new(verts.as_slice().into()).ok()?;
+            builds.push(millis(start));
+            let start = Instant::now();
+            for (slot, ray) in hits.iter_mut().zip(&rays) {
+                let mut r = *ray;
+                bvh.intersect(&mut r);
+                *slot = if r.hit.t < ray.hit.t {
+                    HitRecord {
+                        t: r.hit.t,
+                        prim: r.hit.prim,
+                    }
+                } else {
+                    HitRecord::MISS
+                };
+            }
+            closest.push(millis(start));
+            bytes = std::mem::size_of_val(bvh.nodes()) + std::mem::size_of_val(bvh.indices());
+        }
+        Some(PeerMeasured {
+            build_ms: median(&builds),
+            setup_ms,
+            closest_ms: median(&closest),
+            hits,
+            bytes,
+            ..empty_measured()
+        })
+    }
+}
+
+/// Without the `tinybvh` feature there is no tinybvh to run.
+#[cfg(not(feature = "tinybvh"))]
+mod tinybvh {
+    use super::PeerMeasured;
+    use crate::rayfile::RayRecord;
+
+    pub(super) fn run(
+        _tris: &[[[f32; 3]; 3]],
+        _records: &[&RayRecord],
+        _runs: usize,
+    ) -> Option<PeerMeasured> {
+        None
     }
 }

@@ -490,9 +490,11 @@ fn quoted_section(s: &mut String, r: &BenchResults) {
     let _ = writeln!(
         s,
         "### Quoted peers\n\n\
-         Figures from the project brief for peers this benchmark cannot run (C++), measured on \
-         this machine kind with the same workload; not rerun here, so each ratio mixes two \
-         runs. Ours: raykernel `f32` 4-wide BVH (collapsed from the SAH BVH), watertight, from this run.\n"
+         Figures from the project brief and the kernel issue, measured on this machine kind \
+         with the same workload, so each ratio mixes two runs. Embree is not built here; \
+         tinybvh's BVH2 is also measured in this run when `host` is built with the `tinybvh` \
+         feature (the headline table). Ours: raykernel `f32` 4-wide BVH (collapsed from the \
+         SAH BVH), watertight, from this run.\n"
     );
     let _ = writeln!(
         s,
@@ -900,13 +902,18 @@ fn notes_section(s: &mut String) {
          - Build: wall time of the call that turns the triangle array into the structure \
          that is traversed (ours: `Bvh::build` into a 64-byte aligned arena; obvhs: \
          `build_bvh2_from_tris` / `build_cwbvh_from_tris` with `BvhBuildParams::medium_build()`; \
-         bvh: `Bvh::build`), parsing excluded.\n\
+         bvh: `Bvh::build`; tinybvh: `BVH::Build`, its default binned SAH build, through \
+         `tinybvh_rs::bvh::BVH::new`), parsing excluded.\n\
          - Trace: wall time of tracing every ray and storing `{{t, prim}}`; turning records \
          into each library's ray type is timed apart (`setup ms`).\n\
          - Peers' triangle tests: obvhs uses its own two-sided Möller–Trumbore; bvh's \
          `intersects_triangle` culls back faces, so its rows use this benchmark's two-sided \
          Möller–Trumbore and its `nearest_traverse_iterator` (boxes in order of entry, stopped \
-         past the best hit). Peers' bytes/tri: obvhs nodes + primitive indices; bvh nodes only.\n\
+         past the best hit); tinybvh traces with its scalar `BVH::Intersect` and its own \
+         Möller–Trumbore (one FFI call per ray; `tinybvh-rs` builds the C++ with \
+         `-march=native`), has no occlusion query in `tinybvh-rs` (any hit not measured) and \
+         does not count primitive tests (n/a). Peers' bytes/tri: obvhs and tinybvh nodes + \
+         primitive indices; bvh nodes only.\n\
          - Criterion micro-benchmarks of the hot functions (slab test, triangle test, one \
          traversal): `cargo bench -p raykernel-host --bench hot`.\n"
     );
