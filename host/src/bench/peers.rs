@@ -35,16 +35,13 @@ pub enum Peer {
 
 impl Peer {
     /// Every peer this build can run (tinybvh with the `tinybvh` feature only).
-    pub const ALL: &'static [Peer] = if cfg!(feature = "tinybvh") {
-        &[
-            Self::TinybvhBvh2,
-            Self::ObvhsBvh2,
-            Self::ObvhsCwbvh,
-            Self::SvenstaroBvh,
-        ]
-    } else {
-        &[Self::ObvhsBvh2, Self::ObvhsCwbvh, Self::SvenstaroBvh]
-    };
+    pub const ALL: &'static [Peer] = &[
+        #[cfg(feature = "tinybvh")]
+        Self::TinybvhBvh2,
+        Self::ObvhsBvh2,
+        Self::ObvhsCwbvh,
+        Self::SvenstaroBvh,
+    ];
 
     /// Name in the report.
     #[must_use]
@@ -97,7 +94,10 @@ pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Op
     let m = match peer {
         Peer::ObvhsBvh2 | Peer::ObvhsCwbvh => obvhs_run(peer, &tris, &records, runs),
         Peer::SvenstaroBvh => svenstaro_run(&tris, &records, runs),
+        #[cfg(feature = "tinybvh")]
         Peer::TinybvhBvh2 => tinybvh::run(&tris, &records, runs)?,
+        #[cfg(not(feature = "tinybvh"))]
+        Peer::TinybvhBvh2 => return None,
     };
     let n = m.hits.len();
     Some(TraceRow {
@@ -511,20 +511,5 @@ mod tinybvh {
             bytes,
             ..empty_measured()
         })
-    }
-}
-
-/// Without the `tinybvh` feature there is no tinybvh to run.
-#[cfg(not(feature = "tinybvh"))]
-mod tinybvh {
-    use super::PeerMeasured;
-    use crate::rayfile::RayRecord;
-
-    pub(super) fn run(
-        _tris: &[[[f32; 3]; 3]],
-        _records: &[&RayRecord],
-        _runs: usize,
-    ) -> Option<PeerMeasured> {
-        None
     }
 }
