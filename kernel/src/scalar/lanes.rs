@@ -13,11 +13,12 @@ mod sse {
     // CPU supporting SSE/SSE2, which `cfg(target_feature = "sse2")` guarantees at compile
     // time (it is part of the x86_64 baseline). None of them touches memory. `to_array`'s
     // transmute copies the 16 bytes of an `__m128` into a `[f32; 4]` of the same size, and
-    // every bit pattern is a valid `f32`.
+    // every bit pattern is a valid `f32`; `clamped_trunc`'s copies an `__m128i` into a
+    // `[u32; 4]`, where every bit pattern is valid too.
     use arch::{
-        __m128, _mm_cmple_ps, _mm_cvtss_f32, _mm_div_ps, _mm_max_ps, _mm_min_ps, _mm_movehl_ps,
-        _mm_movemask_ps, _mm_mul_ps, _mm_set1_ps, _mm_setr_ps, _mm_shuffle_ps, _mm_sub_ps,
-        _mm_unpackhi_ps, _mm_unpacklo_ps,
+        __m128, __m128i, _mm_add_ps, _mm_cmple_ps, _mm_cvtss_f32, _mm_cvttps_epi32, _mm_div_ps,
+        _mm_max_ps, _mm_min_ps, _mm_movehl_ps, _mm_movemask_ps, _mm_mul_ps, _mm_set1_ps,
+        _mm_setr_ps, _mm_shuffle_ps, _mm_sub_ps, _mm_unpackhi_ps, _mm_unpacklo_ps,
     };
     #[cfg(target_arch = "x86")]
     use core::arch::x86 as arch;
@@ -36,6 +37,10 @@ mod sse {
         #[inline(always)]
         pub(crate) fn splat(x: f32) -> Self {
             Self(unsafe { _mm_set1_ps(x) })
+        }
+        #[inline(always)]
+        pub(crate) fn add(self, o: Self) -> Self {
+            Self(unsafe { _mm_add_ps(self.0, o.0) })
         }
         #[inline(always)]
         pub(crate) fn sub(self, o: Self) -> Self {
@@ -78,6 +83,14 @@ mod sse {
         #[inline(always)]
         pub(crate) fn high_half(self) -> Self {
             Self(unsafe { _mm_movehl_ps(self.0, self.0) })
+        }
+        /// Per lane `(x as i32).clamp(0, top)` for a whole `top` in `0..=2^24`: the lane
+        /// clamped to `[0, top]` (NaN to 0), then truncated, which is exact in that range.
+        #[inline(always)]
+        pub(crate) fn clamped_trunc(self, top: f32) -> [u32; 4] {
+            let x = self.max(Self::splat(0.0)).min(Self::splat(top));
+            let bins: __m128i = unsafe { _mm_cvttps_epi32(x.0) };
+            unsafe { core::mem::transmute::<__m128i, [u32; 4]>(bins) }
         }
         /// Bit `i` set if lane `i` of `self <= o` (false when unordered).
         #[inline(always)]
@@ -131,6 +144,10 @@ mod portable {
                 | u32::from(f(a3, b3)) << 3
         }
         #[inline(always)]
+        pub(crate) fn add(self, o: Self) -> Self {
+            self.zip(o, |a, b| a + b)
+        }
+        #[inline(always)]
         pub(crate) fn sub(self, o: Self) -> Self {
             self.zip(o, |a, b| a - b)
         }
@@ -168,6 +185,11 @@ mod portable {
         pub(crate) fn high_half(self) -> Self {
             let a = self.0;
             Self([a[2], a[3], a[2], a[3]])
+        }
+        #[inline(always)]
+        pub(crate) fn clamped_trunc(self, top: f32) -> [u32; 4] {
+            let x = self.max(Self::splat(0.0)).min(Self::splat(top));
+            x.0.map(|v| v as u32)
         }
         #[inline(always)]
         pub(crate) fn le_mask(self, o: Self) -> u32 {
@@ -234,6 +256,7 @@ mod tests {
                     "{what} {a:?} {b:?}"
                 );
             };
+            same(pa.add(pb), sa.add(sb), "add");
             same(pa.sub(pb), sa.sub(sb), "sub");
             same(pa.mul(pb), sa.mul(sb), "mul");
             same(pa.div(pb), sa.div(sb), "div");
@@ -250,6 +273,13 @@ mod tests {
             assert_eq!(pa.sign_mask(), sa.sign_mask(), "sign_mask {a:?}");
             same(P::splat(a[0]), S::splat(a[0]), "splat");
             assert_eq!(pa.le_mask(pb), sa.le_mask(sb), "le_mask {a:?} {b:?}");
+            for top in [0.0, 3.0, 31.0, 16_777_216.0] {
+                assert_eq!(
+                    pa.clamped_trunc(top),
+                    sa.clamped_trunc(top),
+                    "clamped_trunc {a:?}"
+                );
+            }
         }
     }
 

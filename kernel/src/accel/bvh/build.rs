@@ -9,6 +9,7 @@ use super::{
 };
 use crate::error::{Arena, BuildError};
 use crate::geom::{Aabb, Primitive};
+use crate::scalar::lanes::F4;
 use crate::scalar::Scalar;
 
 /// Bins per axis for the SAH builder.
@@ -273,6 +274,14 @@ fn lanes<S: Scalar>(v: &[S; 3]) -> [S; 4] {
     [v[0], v[1], v[2], v[2]]
 }
 
+/// The [`key`]s of a box on every axis, from its corners as four lanes.
+#[inline(always)]
+fn centroid<S: Scalar>(lo: &[S; 4], hi: &[S; 4]) -> F4 {
+    let half = F4::splat(0.5);
+    let (lo, hi) = (F4::new(lo.map(S::to_f32)), F4::new(hi.map(S::to_f32)));
+    lo.mul(half).add(hi.mul(half))
+}
+
 /// A node waiting to be split.
 #[derive(Clone, Copy)]
 struct Pending {
@@ -310,11 +319,9 @@ impl<S: Scalar> Side<S> {
         self.count += 1;
         let (lo, hi) = (lanes(&b.lo), lanes(&b.hi));
         self.bin.grow(&lo, &hi);
-        for k in 0..4 {
-            let c = lo[k].to_f32() * 0.5 + hi[k].to_f32() * 0.5;
-            self.centroid_lo[k] = self.centroid_lo[k].min_of(c);
-            self.centroid_hi[k] = self.centroid_hi[k].max_of(c);
-        }
+        let c = centroid(&lo, &hi);
+        self.centroid_lo = F4::new(self.centroid_lo).min(c).to_array();
+        self.centroid_hi = F4::new(self.centroid_hi).max(c).to_array();
     }
 
     fn bounds(&self) -> Aabb<S> {
@@ -528,19 +535,17 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         }
         // Bin each primitive on all three axes, remembering its bins in the slot's tag (when it
         // keeps one) for the partition below.
-        let (origin, scale4, top) = (lanes(clo), lanes(&scale), (nb - 1) as f32);
+        let (origin, scale4) = (F4::new(lanes(clo)), F4::new(lanes(&scale)));
+        let top = (nb - 1) as f32;
         for id in ids.iter_mut() {
             let b = id.bounds(self.prims);
             let (lo, hi) = (lanes(&b.lo), lanes(&b.hi));
-            let bin = bin_lanes(
-                core::array::from_fn(|k| {
-                    let c = lo[k].to_f32() * 0.5 + hi[k].to_f32() * 0.5;
-                    (c - origin[k]) * scale4[k]
-                }),
-                top,
-            );
+            let bin = centroid(&lo, &hi)
+                .sub(origin)
+                .mul(scale4)
+                .clamped_trunc(top);
             // Each bin is below `nb <= 32`: five bits per axis.
-            id.set_tag((bin[0] | bin[1] << 5 | bin[2] << 10) as u32);
+            id.set_tag(bin[0] | bin[1] << 5 | bin[2] << 10);
             for ((boxes, counts), bin) in bins.boxes.iter_mut().zip(bins.counts.iter_mut()).zip(bin)
             {
                 // `% BINS` is a no-op (bins < nb <= BINS) that shows the compiler the bound.
@@ -561,7 +566,7 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
             let bin = if T::TAGGED {
                 (id.tag() >> shift) as usize & 31
             } else {
-                bin_lanes([(key(b, axis) - origin) * scale; 4], top)[0] as usize
+                F4::splat((key(b, axis) - origin) * scale).clamped_trunc(top)[0] as usize
             };
             bin <= last_left_bin
         }))
@@ -591,22 +596,6 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         }
         Some(axis)
     }
-}
-
-/// The bins of four scaled centroid offsets: per lane `(f as i32).clamp(0, top)` (a saturating
-/// cast, NaN to 0, then clamped; `top` is a whole number below 32), computed with float
-/// operations only so that all four lanes go through the same vector instructions.
-#[inline(always)]
-fn bin_lanes(f: [f32; 4], top: f32) -> [u32; 4] {
-    // 1.5 * 2^23: adding it to a number in [0, 2^22] rounds that to a whole number.
-    const MAGIC: f32 = 12_582_912.0;
-    core::array::from_fn(|k| {
-        let x = if f[k] > 0.0 { f[k] } else { 0.0 }; // negative and NaN: 0
-        let x = if x < top { x } else { top }; // then x as i32 == (f as i32).clamp(0, top)
-        let rounded = x + MAGIC; // x rounded to a whole number, plus MAGIC
-                                 // Truncated: one less if rounded up (an integer subtraction: no select to branch on).
-        (rounded.to_bits() - MAGIC.to_bits()) - u32::from(rounded - MAGIC > x)
-    })
 }
 
 /// Best SAH split over the bins (filled by [`Builder::sah`]): (cost, axis, last bin of the
@@ -683,7 +672,7 @@ fn sweep<S: Scalar>(
 
 #[cfg(test)]
 mod tests {
-    use super::bin_lanes;
+    use crate::scalar::lanes::F4;
 
     /// The bin of `f` as the builder first computed it.
     fn bin_reference(f: f32, top: i32) -> u32 {
@@ -691,7 +680,7 @@ mod tests {
     }
 
     #[test]
-    fn bin_lanes_is_the_saturating_cast_clamped() {
+    fn bins_are_the_saturating_cast_clamped() {
         let special = [
             f32::NAN,
             -f32::NAN,
@@ -731,7 +720,7 @@ mod tests {
         {
             for top in 3..32 {
                 let want = bin_reference(f, top);
-                let got = bin_lanes([f, 0.0, f, -f], top as f32);
+                let got = F4::new([f, 0.0, f, -f]).clamped_trunc(top as f32);
                 assert_eq!(got[0], want, "f = {f:e} ({:#x}), top = {top}", f.to_bits());
                 assert_eq!(got[2], want, "f = {f:e}, top = {top}");
                 assert_eq!(got[3], bin_reference(-f, top), "f = {:e}, top = {top}", -f);
