@@ -299,8 +299,8 @@ type Centroids = ([f32; 3], [f32; 3]);
 struct Side<S: Scalar> {
     count: usize,
     bin: Bin<S>,
-    centroid_lo: [f32; 4],
-    centroid_hi: [f32; 4],
+    centroid_lo: F4,
+    centroid_hi: F4,
 }
 
 impl<S: Scalar> Side<S> {
@@ -308,8 +308,8 @@ impl<S: Scalar> Side<S> {
         Self {
             count: 0,
             bin: Bin::empty(),
-            centroid_lo: [f32::INFINITY; 4],
-            centroid_hi: [f32::NEG_INFINITY; 4],
+            centroid_lo: F4::splat(f32::INFINITY),
+            centroid_hi: F4::splat(f32::NEG_INFINITY),
         }
     }
 
@@ -320,8 +320,8 @@ impl<S: Scalar> Side<S> {
         let (lo, hi) = (lanes(&b.lo), lanes(&b.hi));
         self.bin.grow(&lo, &hi);
         let c = centroid(&lo, &hi);
-        self.centroid_lo = F4::new(self.centroid_lo).min(c).to_array();
-        self.centroid_hi = F4::new(self.centroid_hi).max(c).to_array();
+        self.centroid_lo = self.centroid_lo.min(c);
+        self.centroid_hi = self.centroid_hi.max(c);
     }
 
     fn bounds(&self) -> Aabb<S> {
@@ -330,7 +330,7 @@ impl<S: Scalar> Side<S> {
     }
 
     fn centroids(&self) -> Centroids {
-        let (lo, hi) = (&self.centroid_lo, &self.centroid_hi);
+        let (lo, hi) = (self.centroid_lo.to_array(), self.centroid_hi.to_array());
         ([lo[0], lo[1], lo[2]], [hi[0], hi[1], hi[2]])
     }
 }
