@@ -362,6 +362,10 @@ pub struct BenchArgs {
     /// Skip the peers.
     #[arg(long)]
     pub no_peers: bool,
+    /// Interleaved rounds per ray set: the headline contender and tinybvh's BVH2 (with the
+    /// `tinybvh` feature) traced in alternation; `0` skips them [default: 7, or 2 with --quick].
+    #[arg(long, value_name = "N")]
+    pub rounds: Option<usize>,
     /// Tiled-scene sizes in triangles, comma-separated; `0` skips the sweep
     /// [default: 10k..2M, or 10k..100k with --quick].
     #[arg(long, value_name = "N,N,...", value_delimiter = ',')]
@@ -739,6 +743,7 @@ pub fn run_bench(args: &BenchArgs) -> Result<BenchReport, Error> {
         stride: args.stride.unwrap_or(if args.quick { 64 } else { 1 }),
         runs: args.runs.unwrap_or(if args.quick { 1 } else { 3 }),
         peers: !args.no_peers,
+        rounds: args.rounds.unwrap_or(if args.quick { 2 } else { 7 }),
         scale: ScaleOptions {
             sizes,
             rays: args

@@ -32,7 +32,15 @@ fn run_bench(scenes: &Path, out: &Path, extra: &[&str]) -> std::process::Output 
         .arg("--scenes")
         .arg(scenes)
         .args(["--scene", "ball", "--scene", "fine"])
-        .args(["--rust-rays", "--rays-per-set", "1024", "--runs", "1"])
+        .args([
+            "--rust-rays",
+            "--rays-per-set",
+            "1024",
+            "--runs",
+            "1",
+            "--rounds",
+            "3",
+        ])
         .args(["--scale", "500,2000", "--scale-rays", "256"])
         .args(["--image-spp", "4"])
         .arg("--out")
@@ -74,6 +82,7 @@ fn bench_writes_a_well_formed_report_csv_json_and_plots() {
     );
     for section in [
         "## Headline",
+        "### Interleaved rounds",
         "## Traversal",
         "## Peers",
         "## Accuracy against an f64 reference",
@@ -137,6 +146,7 @@ fn bench_writes_a_well_formed_report_csv_json_and_plots() {
         "scale",
         "images",
         "fit",
+        "rounds",
     ] {
         assert!(sections.contains(s), "no {s} figures in the CSV");
     }
@@ -163,6 +173,21 @@ fn bench_writes_a_well_formed_report_csv_json_and_plots() {
             assert_eq!(row["vs_ours"]["hitmiss"], 0, "{row}");
         }
     }
+    // Interleaved rounds: one row per scene and ray set, three rounds of ours, and three of
+    // tinybvh when the peer is in this build.
+    let rounds = json["rounds"].as_array().unwrap();
+    assert_eq!(rounds.len(), 2 * 2);
+    let with_tinybvh =
+        host::bench::peers::Peer::ALL.contains(&host::bench::peers::Peer::TinybvhBvh2);
+    for row in rounds {
+        assert_eq!(row["ray_count"], 1024, "{row}");
+        let ours = row["ours_mrays"].as_array().unwrap();
+        assert_eq!(ours.len(), 3, "{row}");
+        assert!(ours.iter().all(|v| v.as_f64().unwrap() > 0.0), "{row}");
+        let peer = row["peer_mrays"].as_array().unwrap();
+        assert_eq!(peer.len(), if with_tinybvh { 3 } else { 0 }, "{row}");
+    }
+
     // Scale: two sizes × two modes, the exact instance triangle counts plus the ground.
     let scale = json["scale"].as_array().unwrap();
     assert_eq!(scale.len(), 4);

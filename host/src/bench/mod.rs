@@ -4,6 +4,8 @@
 //! - [`ours`]: the kernel's contenders (every accelerator, builder and mode, plus the
 //!   benchmark-only Möller–Trumbore contrast of [`mt`]),
 //! - [`peers`]: `obvhs` (BVH2, CWBVH) and `bvh`, measured in the same run,
+//! - [`rounds`]: the headline contender and tinybvh's BVH2 traced in alternation, round by
+//!   round,
 //! - [`accuracy`]: the `f64` reference and each contender's hit-distance error,
 //! - [`scale`]: the tiled scene from 10k to 1M+ triangles,
 //! - [`images`]: the renderer's image error against time, per sampler,
@@ -23,6 +25,7 @@ pub mod peers;
 pub mod plot;
 pub mod report;
 pub mod results;
+pub mod rounds;
 pub mod scale;
 pub mod stats;
 pub mod workload;
@@ -51,6 +54,8 @@ pub struct BenchConfig {
     pub runs: usize,
     /// Measure the peers too.
     pub peers: bool,
+    /// Interleaved rounds per ray set (0: skipped); see [`rounds`].
+    pub rounds: usize,
     /// The tiled-scene sweep (empty sizes: skipped).
     pub scale: scale::ScaleOptions,
     /// The image-convergence renders (`None`: skipped).
@@ -88,6 +93,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
     }
     let mut rows = Vec::new();
     let mut references = Vec::new();
+    let mut round_rows = Vec::new();
     for scene in &scenes {
         let tris: Vec<[[f32; 3]; 3]> = (0..scene.mesh.triangle_count())
             .map(|i| scene.mesh.triangle_f32(i))
@@ -105,6 +111,10 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
                     eprintln!("bench:   {}", peer.name());
                     set_rows.extend(peers::run(peer, scene, set, opts));
                 }
+            }
+            if config.rounds > 0 {
+                eprintln!("bench:   interleaved rounds ({})", config.rounds);
+                round_rows.push(rounds::run(scene, set, opts, config.rounds, config.peers)?);
             }
             let reference = accuracy::Reference::compute(&tris, &set.records, stride, threads)
                 .map_err(|source| Error::Build {
@@ -161,6 +171,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
             ),
         },
         rows,
+        rounds: round_rows,
         reference: references,
         scale: scale_rows,
         images: image_rows,

@@ -132,6 +132,25 @@ pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Op
     })
 }
 
+/// Builds tinybvh's BVH2 once, then runs `rounds` rounds of `ours()` followed by one timed
+/// closest-hit pass of tinybvh over `records`; returns tinybvh's Mrays/s per round. `None`
+/// without the `tinybvh` feature, or if tinybvh refuses the scene (then `ours` never ran).
+#[must_use]
+pub fn alternate_with_tinybvh(
+    tris: &[[[f32; 3]; 3]],
+    records: &[&crate::rayfile::RayRecord],
+    rounds: usize,
+    ours: &mut dyn FnMut(),
+) -> Option<Vec<f64>> {
+    #[cfg(feature = "tinybvh")]
+    return tinybvh::alternate(tris, records, rounds, ours);
+    #[cfg(not(feature = "tinybvh"))]
+    {
+        let _ = (tris, records, rounds, ours);
+        None
+    }
+}
+
 /// The two obvhs structures share this query surface.
 trait ObvhsQueries {
     fn closest<F: FnMut(&obvhs::ray::Ray, usize) -> f32>(
@@ -451,7 +470,7 @@ mod tinybvh {
     use crate::rayfile::{HitRecord, RayRecord};
     use crate::trace::{median, millis};
     use std::time::Instant;
-    use tinybvh_rs::{bvh::BVH, Intersector, Ray, INFINITE};
+    use tinybvh_rs::{bvh::BVH, Intersection, Intersector, Ray, INFINITE};
 
     /// Builds `runs` times (`BVH::new`: tinybvh's default binned SAH build) and traces every
     /// ray after each build with `BVH::Intersect`, its scalar BVH2 traversal. The workload's
@@ -464,20 +483,9 @@ mod tinybvh {
         records: &[&RayRecord],
         runs: usize,
     ) -> Option<PeerMeasured> {
-        // tinybvh reads vertices as four floats each, three per triangle.
-        let verts: Vec<[f32; 4]> = tris
-            .iter()
-            .flat_map(|t| t.map(|p| [p[0], p[1], p[2], 0.0]))
-            .collect();
+        let verts = vertices(tris);
         let start = Instant::now();
-        let rays: Vec<Ray> = records
-            .iter()
-            .map(|r| {
-                let mut ray = Ray::new(r.origin, r.dir);
-                ray.hit.t = r.t_max.min(INFINITE);
-                ray
-            })
-            .collect();
+        let rays = rays(records);
         let setup_ms = millis(start);
         let mut builds = Vec::new();
         let mut closest = Vec::new();
@@ -487,20 +495,7 @@ mod tinybvh {
             let start = Instant::now();
             let bvh = BVH::new(verts.as_slice().into()).ok()?;
             builds.push(millis(start));
-            let start = Instant::now();
-            for (slot, ray) in hits.iter_mut().zip(&rays) {
-                let mut r = *ray;
-                bvh.intersect(&mut r);
-                *slot = if r.hit.t < ray.hit.t {
-                    HitRecord {
-                        t: r.hit.t,
-                        prim: r.hit.prim,
-                    }
-                } else {
-                    HitRecord::MISS
-                };
-            }
-            closest.push(millis(start));
+            closest.push(trace(&bvh, &rays, &mut hits));
             bytes = std::mem::size_of_val(bvh.nodes()) + std::mem::size_of_val(bvh.indices());
         }
         Some(PeerMeasured {
@@ -511,5 +506,103 @@ mod tinybvh {
             bytes,
             ..empty_measured()
         })
+    }
+
+    /// See [`super::alternate_with_tinybvh`].
+    pub(super) fn alternate(
+        tris: &[[[f32; 3]; 3]],
+        records: &[&RayRecord],
+        rounds: usize,
+        ours: &mut dyn FnMut(),
+    ) -> Option<Vec<f64>> {
+        let verts = vertices(tris);
+        let rays = rays(records);
+        let bvh = BVH::new(verts.as_slice().into()).ok()?;
+        let mut hits = vec![HitRecord::MISS; rays.len()];
+        let mut out = Vec::with_capacity(rounds);
+        for _ in 0..rounds {
+            ours();
+            out.push(super::mrays(rays.len(), trace(&bvh, &rays, &mut hits)));
+        }
+        Some(out)
+    }
+
+    /// tinybvh reads vertices as four floats each, three per triangle.
+    fn vertices(tris: &[[[f32; 3]; 3]]) -> Vec<[f32; 4]> {
+        tris.iter()
+            .flat_map(|t| t.map(|p| [p[0], p[1], p[2], 0.0]))
+            .collect()
+    }
+
+    /// A ray as tinybvh's C++ `Ray` lays it out: 128 bytes, aligned to 64. The binding's
+    /// `Ray` is the first 64 bytes; tinybvh 1.6.8's `Intersection` grew 64 bytes of user
+    /// data that the binding (0.1.0-beta.3) does not declare, and its fields `t` and `prim`
+    /// sit at the offsets of the binding's `hit.t` and `hit.prim` (48 and 60). Handing the C++
+    /// side a pointer into this padded slot keeps every byte it may touch inside our object.
+    #[repr(C, align(64))]
+    #[derive(Clone, Copy)]
+    struct CppRay {
+        ray: Ray,
+        user_data: [u8; 64],
+    }
+    const _: () = assert!(std::mem::size_of::<CppRay>() == 128);
+
+    /// The records as tinybvh rays, built as tinybvh's `Ray(origin, direction, t)`
+    /// constructor does (direction normalised, reciprocal by `tinybvh_safercp`), in Rust:
+    /// the binding's `Ray::new` returns the 128-byte C++ `Ray` by value into a 64-byte
+    /// Rust one, overwriting 64 bytes of the caller's stack (seen as a crash). `t_max` is the
+    /// hit distance on entry.
+    fn rays(records: &[&RayRecord]) -> Vec<CppRay> {
+        let far = INFINITE;
+        let safe_rcp = |x: f32| {
+            if x.abs() > 1e-12 {
+                1.0 / x
+            } else if x >= 0.0 {
+                far
+            } else {
+                -far
+            }
+        };
+        records
+            .iter()
+            .map(|r| {
+                let [x, y, z] = r.dir;
+                let len = (x * x + y * y + z * z).sqrt();
+                let rl = if len == 0.0 { 0.0 } else { 1.0 / len };
+                let dir = [x * rl, y * rl, z * rl];
+                let ray = Ray {
+                    origin: r.origin,
+                    dir,
+                    r_d: dir.map(safe_rcp),
+                    hit: Intersection {
+                        t: r.t_max.min(far),
+                        ..Intersection::default()
+                    },
+                    ..Ray::default()
+                };
+                CppRay {
+                    ray,
+                    user_data: [0; 64],
+                }
+            })
+            .collect()
+    }
+
+    /// One closest-hit pass into `hits`; returns its wall time, ms.
+    fn trace(bvh: &BVH<'_>, rays: &[CppRay], hits: &mut [HitRecord]) -> f64 {
+        let start = Instant::now();
+        for (slot, ray) in hits.iter_mut().zip(rays) {
+            let mut r = *ray;
+            bvh.intersect(&mut r.ray);
+            *slot = if r.ray.hit.t < ray.ray.hit.t {
+                HitRecord {
+                    t: r.ray.hit.t,
+                    prim: r.ray.hit.prim,
+                }
+            } else {
+                HitRecord::MISS
+            };
+        }
+        millis(start)
     }
 }
