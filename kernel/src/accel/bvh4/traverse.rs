@@ -85,21 +85,40 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                     let hit = hit & used;
                     // None hit: fall through to the pop below.
                     if hit != 0 {
-                        let i = hit.trailing_zeros() as usize & 3;
                         let others = hit & (hit - 1);
                         if others == 0 {
                             // One child hit (the common case deep in the tree): go there.
-                            (child, count) = (node.child[i], node.count[i]);
+                            // A branch per slot, not an index computed from the mask: the
+                            // branch predictor can then fetch the next node before this box
+                            // test has finished, where an index would wait for it.
+                            (child, count) = match hit {
+                                1 => (node.child[0], node.count[0]),
+                                2 => (node.child[1], node.count[1]),
+                                4 => (node.child[2], node.count[2]),
+                                _ => (node.child[3], node.count[3]),
+                            };
                             continue 'walk;
                         }
-                        let j = others.trailing_zeros() as usize & 3;
                         if others & (others - 1) == 0 {
                             // Two: visit the nearer (the first on a tie), push the other.
-                            let (a, b) = (
-                                (node.child[i], node.count[i], t[i]),
-                                (node.child[j], node.count[j], t[j]),
-                            );
-                            let (near, far) = if b.2 < a.2 { (b, a) } else { (a, b) };
+                            // Slots by branch again (see above).
+                            let pair = |i: usize, j: usize| {
+                                let a = (node.child[i], node.count[i], t[i]);
+                                let b = (node.child[j], node.count[j], t[j]);
+                                if b.2 < a.2 {
+                                    (b, a)
+                                } else {
+                                    (a, b)
+                                }
+                            };
+                            let (near, far) = match hit {
+                                0b0011 => pair(0, 1),
+                                0b0101 => pair(0, 2),
+                                0b1001 => pair(0, 3),
+                                0b0110 => pair(1, 2),
+                                0b1010 => pair(1, 3),
+                                _ => pair(2, 3),
+                            };
                             let _ = stack.push(far);
                             (child, count) = (near.0, near.1);
                             continue 'walk;
