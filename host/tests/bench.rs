@@ -27,7 +27,7 @@ fn scenes(name: &str) -> PathBuf {
 }
 
 fn run_bench(scenes: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_host"))
+    Command::new(env!("CARGO_BIN_EXE_raykernel"))
         .arg("bench")
         .arg("--scenes")
         .arg(scenes)
@@ -238,7 +238,7 @@ fn bench_without_the_shared_scenes_says_what_is_missing() {
     );
     // Ray files asked for but absent: named, with the command that makes them.
     let scenes = scenes("bench_missing_rays");
-    let output = Command::new(env!("CARGO_BIN_EXE_host"))
+    let output = Command::new(env!("CARGO_BIN_EXE_raykernel"))
         .arg("bench")
         .arg("--scenes")
         .arg(&scenes)
