@@ -663,3 +663,90 @@ fn special_files_as_mesh_paths_fail_fast_with_what_they_are() {
         assert!(e.ends_with(want), "{e}");
     }
 }
+
+#[test]
+fn dump_of_an_obj_names_the_mesh_and_the_real_focus_and_renders_the_same_bytes() {
+    let dir = temp_dir("dump_obj");
+    std::fs::create_dir_all(dir.join("meshes")).unwrap();
+    std::fs::create_dir_all(dir.join("out")).unwrap();
+    let obj = dir.join("meshes/ball.obj");
+    std::fs::write(&obj, common::icosphere([0.0; 3], 1.0, 2).to_obj()).unwrap();
+    let json = dir.join("out/ball.json");
+    let camera = [
+        "--eye",
+        "0,1,6",
+        "--look-at",
+        "0,0,0",
+        "--vfov",
+        "35",
+        "--aperture",
+        "0.05",
+    ];
+    let small = [
+        "--width",
+        "20",
+        "--height",
+        "16",
+        "--spp",
+        "2",
+        "--threads",
+        "2",
+    ];
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_raykernel"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    let (a_png, b_png) = (dir.join("a.png"), dir.join("b.png"));
+    let mut a = vec![
+        "render",
+        obj.to_str().unwrap(),
+        "--out",
+        a_png.to_str().unwrap(),
+    ];
+    a.extend(camera);
+    a.extend(small);
+    a.extend(["--dump-scene", json.to_str().unwrap()]);
+    run(&a);
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["objects"][0]["mesh"], "../meshes/ball.obj");
+    assert!(v["objects"][0].get("triangles").is_none());
+    let c = &v["camera"];
+    assert_eq!(
+        (c["eye"].clone(), c["vfov_deg"].clone()),
+        (json!([0.0, 1.0, 6.0]), json!(35.0))
+    );
+    assert_eq!(c["aperture_radius"], json!(0.05));
+    let focus = c["focus_distance"].as_f64().unwrap();
+    assert!((focus - 37f64.sqrt()).abs() < 1e-6, "{focus}");
+    run(&[
+        "render",
+        json.to_str().unwrap(),
+        "--out",
+        b_png.to_str().unwrap(),
+    ]);
+    assert_eq!(std::fs::read(a_png).unwrap(), std::fs::read(b_png).unwrap());
+    // Without camera flags the framed camera's focus is its distance to the target, not 1.
+    run(&[
+        "render",
+        obj.to_str().unwrap(),
+        "--dump-scene",
+        json.to_str().unwrap(),
+    ]);
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let c = &v["camera"];
+    let eye: Vec<f64> = serde_json::from_value(c["eye"].clone()).unwrap();
+    let at: Vec<f64> = serde_json::from_value(c["look_at"].clone()).unwrap();
+    let d = (0..3).map(|k| (eye[k] - at[k]).powi(2)).sum::<f64>().sqrt();
+    let focus = c["focus_distance"].as_f64().unwrap();
+    assert!(
+        (focus - d).abs() < 1e-4 * d && d > 2.0,
+        "focus {focus}, eye to look_at {d}"
+    );
+}

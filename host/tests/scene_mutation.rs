@@ -6,7 +6,7 @@
 //! and a tiny render in both modes. None may panic, and none may take long: bad input gets a
 //! typed error, within the stated bounds.
 //!
-//! `RAYKERNEL_MUTATIONS` sets the copies per scene (default 150; CI runs more under an
+//! `RAYKERNEL_MUTATIONS` sets the copies per scene (default 50; CI runs more under an
 //! address-space limit, see `.ci/run`). Each case prints nothing unless it fails, when the
 //! seed and the mutated text (shortened) are in the message.
 
@@ -185,7 +185,7 @@ fn mutate(v: &mut Value, rng: &mut Rng, specials: &[String]) {
         // Grow a list past its bounds (lights) or by many entries (materials, objects).
         6 => {
             let key = ["lights", "materials", "objects"][rng.below(3)];
-            let n = [9, 100, 5000][rng.below(3)];
+            let n = [9, 100, 1000][rng.below(3)];
             if let Some(Value::Array(a)) = v.get_mut(key) {
                 if let Some(first) = a.first().cloned() {
                     a.extend(std::iter::repeat_n(first, n));
@@ -292,7 +292,7 @@ fn mutated_scene_files_never_panic_abort_or_hang() {
     let per_scene: usize = std::env::var("RAYKERNEL_MUTATIONS")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(150);
+        .unwrap_or(50);
     let dir = temp_dir("scene_mutation");
     std::fs::write(
         dir.join("binary.obj"),
