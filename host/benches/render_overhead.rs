@@ -7,7 +7,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use host::bench::overhead::{with_fixture, Workload, SIZE};
-use raykernel::geom::spawn::SpawnScalar;
+use raykernel::spawn::SpawnScalar;
 use raykernel::I16F16;
 
 fn bench_mode<S: SpawnScalar>(c: &mut Criterion) {
