@@ -30,7 +30,7 @@
 //! assert_eq!((hit.t, hit.prim), (5.0, 0));
 //! ```
 #![no_std]
-// The one exception: SSE intrinsics in `scalar/lanes.rs` (see there).
+// The one exception: SSE and NEON intrinsics in `scalar/lanes.rs` (see there).
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
