@@ -40,6 +40,7 @@ pub mod geom;
 pub mod render;
 pub mod scalar;
 
+pub use accel::baked::{self, BakeError, Baked};
 pub use accel::bvh::{self, Bvh, Node};
 pub use accel::bvh4::{self, Bvh4, Node4};
 pub use accel::grid::{self, Grid, GridOptions};
