@@ -44,6 +44,7 @@ mod error {
     pub(crate) use crate::scalar::{PointError, RayError};
 }
 
+pub use accel::baked::{BakeError, Baked};
 pub use accel::bvh::{Bvh, Node};
 pub use accel::bvh4::{Bvh4, Node4};
 pub use accel::grid::Grid;
@@ -57,7 +58,16 @@ pub use scalar::{PointError, RayError, Scalar, Vec3x, F32_COORD_LIMIT, FIXED_COO
 pub mod bvh {
     pub use crate::accel::bvh::{
         nodes_needed, BuildOptions, BuilderKind, InvalidTree, TreeStats, DEFAULT_LEAF_SIZE,
-        MAX_DEPTH, MAX_LEAF_SIZE, MEDIAN_FALLBACK_DEPTH,
+        MAX_DEPTH, MAX_LEAF_SIZE, MEDIAN_FALLBACK_DEPTH, RefitError, TreeShape,
+    };
+}
+
+/// The baked format: a built BVH or 4-wide BVH with its primitives as bytes, and its loader.
+pub mod baked {
+    pub use crate::accel::baked::{
+        bake_bvh, bake_bvh4, baked_len, checksum, load_bvh, load_bvh4, read_header, BakedKind,
+        BakedMode, BakedScalar, Header, FLAG_LEAF_ORDER, HEADER_LEN, MAGIC, MAX_ALIGN,
+        TRIANGLE_LEN, VERSION,
     };
 }
 

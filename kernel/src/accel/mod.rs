@@ -4,6 +4,7 @@
 //! ([`bvh`], and its 4-wide form [`bvh4`]), a uniform spatial subdivision ([`grid`]) and an axis-aligned binary space
 //! partition ([`kdtree`]); and brute force ([`Linear`]), the reference.
 
+pub(crate) mod baked;
 pub(crate) mod bvh;
 pub(crate) mod bvh4;
 mod error;

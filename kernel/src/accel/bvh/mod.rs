@@ -15,11 +15,15 @@
 mod build;
 mod node;
 mod optimize;
+mod parts;
+mod refit;
 mod select;
 mod traverse;
 mod validate;
 
 pub use node::Node;
+pub(crate) use refit::{check_prims, leaf_bounds};
+pub use refit::{RefitError, TreeShape};
 pub(crate) use traverse::{test_leaf, LeafPrims};
 pub(crate) use validate::check_permutation;
 pub use validate::{InvalidTree, TreeStats};

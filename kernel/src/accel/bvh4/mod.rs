@@ -18,6 +18,8 @@
 
 mod collapse;
 mod node;
+mod parts;
+mod refit;
 mod traverse;
 mod validate;
 
