@@ -6,7 +6,7 @@
 //! `cargo bench -p raykernel-bench --bench render_overhead`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use raykernel::geom::spawn::SpawnScalar;
+use raykernel::spawn::SpawnScalar;
 use raykernel::I16F16;
 use raykernel_bench::overhead::{with_fixture, Workload, SIZE};
 

@@ -16,12 +16,12 @@
 use host::mesh::unit_icosphere;
 use host::trace::NodeArena;
 use raykernel::bvh::{nodes_needed, BuildOptions};
-use raykernel::geom::spawn::{spawn_shadow_ray, SpawnScalar};
 use raykernel::glam::Vec3;
 use raykernel::render::{
     encode_srgb8, AccelChoice, AccelMemory, Camera, Light, Material, Object, ObjectSlot, Renderer,
     Scene, Settings, Shape,
 };
+use raykernel::spawn::{spawn_shadow_ray, SpawnScalar};
 use raykernel::{Accel, Bvh, Ray, Triangle, I16F16};
 use serde::Serialize;
 use std::hint::black_box;

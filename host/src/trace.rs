@@ -18,8 +18,8 @@ use crate::rayfile::{HitRecord, RayRecord};
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
 use raykernel::{
-    kdtree, Accel, Bvh, Bvh4, Grid, GridOptions, KdNode, KdOptions, KdTree, Linear, Node, Node4,
-    Primitive, Ray, Scalar, Triangle, I16F16,
+    grid::GridOptions, kdtree, kdtree::KdOptions, Accel, Bvh, Bvh4, Grid, KdNode, KdTree, Linear,
+    Node, Node4, Primitive, Ray, Scalar, Triangle, I16F16,
 };
 use std::path::Path;
 use std::time::Instant;

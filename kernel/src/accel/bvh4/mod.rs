@@ -24,7 +24,7 @@ mod validate;
 pub use node::Node4;
 
 use crate::accel::bvh::Bvh;
-use crate::error::BuildError;
+use crate::accel::BuildError;
 use crate::geom::Primitive;
 use crate::scalar::Scalar;
 use core::marker::PhantomData;
