@@ -13,12 +13,10 @@
 //! - [`render`]: parallel tiles over the kernel's distribution ray tracer, PNG and PFM out,
 //! - [`check`]: every way of rendering gives the same bytes,
 //! - [`snapshot`]: exact comparison with golden images and hashes,
-//! - [`bench`]: `host bench`, speed and accuracy with peers in one run (report, data, plots),
 //! - [`cli`]: the command line (clap) and the commands behind it,
 //! - [`error`]: the error type `main` turns into a message and an exit code.
 #![forbid(unsafe_code)]
 
-pub mod bench;
 pub mod check;
 pub mod classify;
 pub mod cli;

@@ -1,7 +1,7 @@
 //! PNG plots with `plotters` (bitmap backend). Text goes through `ab_glyph` with an embedded
 //! font (Hack Regular, from `epaint_default_fonts`), so no system font or fontconfig is needed.
 
-use super::stats::loglog_fit;
+use crate::stats::loglog_fit;
 use plotters::prelude::*;
 use std::path::Path;
 use std::sync::Once;

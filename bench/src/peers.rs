@@ -1,21 +1,23 @@
-//! Peers measured in the same run, on the same triangles and rays: `obvhs` 0.4 (BVH2 and
+//! Peers measured in the same run, on the same triangles and rays: with the `embree` feature,
+//! Embree 3 at HIGH and MEDIUM build quality ([`crate::embree`]); `obvhs` 0.4 (BVH2 and
 //! CWBVH, its own two-sided Möller–Trumbore test), `bvh` 0.13 (svenstaro; its triangle test
 //! culls back faces, so it traces with this benchmark's two-sided Möller–Trumbore from
-//! [`super::mt`], as the workload's triangles are two-sided) and, with the `tinybvh` feature,
+//! [`crate::mt`], as the workload's triangles are two-sided) and, with the `tinybvh` feature,
 //! tinybvh 1.6.8's scalar BVH2 (C++, through `tinybvh-rs`).
 //!
-//! Each peer is used as its documentation shows, single-threaded (no rayon features): build
-//! from the triangle list, then one query per ray. Times and figures follow our rows: build
-//! wall time of the library call, rays converted to the peer's ray type before timing, medians
-//! over the runs.
+//! Each peer is used as its documentation shows, single-threaded (no rayon features; Embree's
+//! device on one thread): build from the triangle list, then one query per ray. Times and
+//! figures follow our rows: build wall time of the library call, medians over the runs.
+//! Embree's call takes the raw ray record; the other peers' rays are converted to their ray
+//! type before timing, and that conversion (`setup_ms`) is added to their per-ray figure.
 
-use super::mt::moller_trumbore;
-use super::ours::{mrays, RunOptions};
-use super::results::TraceRow;
-use super::workload::{BenchScene, RaySet};
-use crate::rayfile::HitRecord;
-use crate::trace::{median, millis};
+use crate::mt::moller_trumbore;
+use crate::ours::{mrays, RunOptions};
+use crate::results::TraceRow;
+use crate::workload::{BenchScene, RaySet};
 use glam_peer::Vec3A;
+use host::rayfile::HitRecord;
+use host::trace::{median, millis};
 use std::cell::Cell;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -31,11 +33,20 @@ pub enum Peer {
     SvenstaroBvh,
     /// tinybvh's BVH2 (`BVH::Build`, binned SAH) and its scalar `BVH::Intersect`.
     TinybvhBvh2,
+    /// Embree 3, `RTC_BUILD_QUALITY_HIGH` (SAH with spatial splits), `rtcIntersect1`.
+    EmbreeHigh,
+    /// Embree 3, `RTC_BUILD_QUALITY_MEDIUM` (SAH), `rtcIntersect1`.
+    EmbreeMedium,
 }
 
 impl Peer {
-    /// Every peer this build can run (tinybvh with the `tinybvh` feature only).
+    /// Every peer this build can run (Embree with the `embree` feature only, tinybvh with the
+    /// `tinybvh` feature only).
     pub const ALL: &'static [Peer] = &[
+        #[cfg(feature = "embree")]
+        Self::EmbreeHigh,
+        #[cfg(feature = "embree")]
+        Self::EmbreeMedium,
         #[cfg(feature = "tinybvh")]
         Self::TinybvhBvh2,
         Self::ObvhsBvh2,
@@ -51,13 +62,23 @@ impl Peer {
             Self::ObvhsCwbvh => "obvhs 0.4 CWBVH",
             Self::SvenstaroBvh => "bvh 0.13",
             Self::TinybvhBvh2 => "tinybvh 1.6 BVH2",
+            Self::EmbreeHigh => "Embree 3 HIGH",
+            Self::EmbreeMedium => "Embree 3 MEDIUM",
         }
+    }
+
+    /// True for Embree (either quality): the peer the headline compares with.
+    #[must_use]
+    pub fn is_embree(self) -> bool {
+        matches!(self, Self::EmbreeHigh | Self::EmbreeMedium)
     }
 
     fn builder(self) -> &'static str {
         match self {
             Self::ObvhsBvh2 | Self::ObvhsCwbvh => "PLOC medium",
             Self::SvenstaroBvh | Self::TinybvhBvh2 => "binned SAH",
+            Self::EmbreeHigh => "SAH + spatial splits",
+            Self::EmbreeMedium => "SAH",
         }
     }
 
@@ -66,6 +87,7 @@ impl Peer {
             Self::ObvhsBvh2 | Self::ObvhsCwbvh => "Möller–Trumbore (obvhs)",
             Self::SvenstaroBvh => "Möller–Trumbore (bench)",
             Self::TinybvhBvh2 => "Möller–Trumbore (tinybvh)",
+            Self::EmbreeHigh | Self::EmbreeMedium => "Embree's",
         }
     }
 }
@@ -81,6 +103,9 @@ struct PeerMeasured {
     /// Primitive tests over all rays, where the peer lets us count them.
     prims_tested: Option<u64>,
     bytes: usize,
+    /// The query takes raw records (Embree): its times include ray setup, and there is no
+    /// pre-built figure.
+    raw_records: bool,
 }
 
 /// Runs one peer on one ray set (`None`: a peer this build cannot run).
@@ -98,6 +123,22 @@ pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Op
         Peer::TinybvhBvh2 => tinybvh::run(&tris, &records, runs)?,
         #[cfg(not(feature = "tinybvh"))]
         Peer::TinybvhBvh2 => return None,
+        #[cfg(feature = "embree")]
+        Peer::EmbreeHigh => embree_peer::run(
+            crate::embree::Quality::High,
+            &scene.mesh,
+            &set.records,
+            opts,
+        )?,
+        #[cfg(feature = "embree")]
+        Peer::EmbreeMedium => embree_peer::run(
+            crate::embree::Quality::Medium,
+            &scene.mesh,
+            &set.records,
+            opts,
+        )?,
+        #[cfg(not(feature = "embree"))]
+        Peer::EmbreeHigh | Peer::EmbreeMedium => return None,
     };
     let n = m.hits.len();
     Some(TraceRow {
@@ -112,8 +153,20 @@ pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Op
         mode: "f32".into(),
         build_ms: m.build_ms,
         setup_ms: m.setup_ms,
-        closest_mrays: mrays(n, m.closest_ms),
-        any_mrays: mrays(n, m.any_ms),
+        setup_ns_per_ray: if n > 0 {
+            m.setup_ms * 1e6 / n as f64
+        } else {
+            0.0
+        },
+        // What a caller pays per ray: the conversion to the peer's ray type, then the query.
+        closest_mrays: mrays(n, m.setup_ms + m.closest_ms),
+        closest_mrays_prebuilt: (!m.raw_records).then(|| mrays(n, m.closest_ms)),
+        any_mrays: if m.any_ms > 0.0 {
+            mrays(n, m.setup_ms + m.any_ms)
+        } else {
+            0.0
+        },
+        any_mrays_prebuilt: (!m.raw_records).then(|| mrays(n, m.any_ms)),
         nodes_per_ray: None,
         prims_per_ray: m
             .prims_tested
@@ -127,9 +180,54 @@ pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Op
         hits: m.hits.iter().filter(|h| h.is_hit()).count(),
         any_hits: m.any_hits,
         vs_ours: None,
+        hitmiss_split: None,
         accuracy: None,
         hit_records: m.hits,
     })
+}
+
+/// Embree through [`crate::embree`], with the `embree` feature.
+#[cfg(feature = "embree")]
+mod embree_peer {
+    use super::{empty_measured, PeerMeasured};
+    use crate::embree::{flat_records, Device, Geometry, Quality, Scene};
+    use crate::ours::RunOptions;
+    use host::obj::Mesh;
+    use host::rayfile::RayRecord;
+    use host::trace::median;
+
+    /// `runs` builds at `quality`, each followed by a closest-hit pass over every
+    /// `opts.stride`-th record; any hit once after the last. `None` if Embree cannot make a
+    /// device or refuses the scene.
+    pub(super) fn run(
+        quality: Quality,
+        mesh: &Mesh,
+        records: &[RayRecord],
+        opts: RunOptions,
+    ) -> Option<PeerMeasured> {
+        let device = Device::new()?;
+        let geometry = Geometry::of(mesh);
+        let flat = flat_records(records);
+        let (mut builds, mut closest) = (Vec::new(), Vec::new());
+        let mut m = empty_measured();
+        for run in 0..opts.runs.max(1) {
+            let (scene, built) = Scene::build(&device, &geometry, quality)?;
+            builds.push(built.build_ms);
+            let (hits, ms) = scene.closest(&flat, opts.stride);
+            closest.push(ms);
+            m.hits = hits;
+            m.bytes = built.bytes;
+            if run + 1 == opts.runs.max(1) {
+                let (occluded, ms) = scene.occluded(&flat, opts.stride);
+                m.any_hits = occluded;
+                m.any_ms = ms;
+            }
+        }
+        m.build_ms = median(&builds);
+        m.closest_ms = median(&closest);
+        m.raw_records = true;
+        Some(m)
+    }
 }
 
 /// Builds tinybvh's BVH2 once, then runs `rounds` rounds of `ours()` followed by one timed
@@ -138,7 +236,7 @@ pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Op
 #[must_use]
 pub fn alternate_with_tinybvh(
     tris: &[[[f32; 3]; 3]],
-    records: &[&crate::rayfile::RayRecord],
+    records: &[&host::rayfile::RayRecord],
     rounds: usize,
     ours: &mut dyn FnMut(),
 ) -> Option<Vec<f64>> {
@@ -199,7 +297,7 @@ obvhs_queries!(obvhs::bvh2::Bvh2, obvhs::cwbvh::CwBvh);
 fn obvhs_run(
     peer: Peer,
     tris: &[[[f32; 3]; 3]],
-    records: &[&crate::rayfile::RayRecord],
+    records: &[&host::rayfile::RayRecord],
     runs: usize,
 ) -> PeerMeasured {
     let v = |p: [f32; 3]| Vec3A::new(p[0], p[1], p[2]);
@@ -253,6 +351,7 @@ fn empty_measured() -> PeerMeasured {
         any_hits: 0,
         prims_tested: None,
         bytes: 0,
+        raw_records: false,
     }
 }
 
@@ -387,7 +486,7 @@ fn sven_closest(
 
 fn svenstaro_run(
     tris: &[[[f32; 3]; 3]],
-    records: &[&crate::rayfile::RayRecord],
+    records: &[&host::rayfile::RayRecord],
     runs: usize,
 ) -> PeerMeasured {
     let start = Instant::now();
@@ -460,6 +559,7 @@ fn svenstaro_run(
         any_hits,
         prims_tested: Some(tested),
         bytes: std::mem::size_of_val(&bvh.nodes[..]),
+        raw_records: false,
     }
 }
 
@@ -467,8 +567,8 @@ fn svenstaro_run(
 #[cfg(feature = "tinybvh")]
 mod tinybvh {
     use super::{empty_measured, PeerMeasured};
-    use crate::rayfile::{HitRecord, RayRecord};
-    use crate::trace::{median, millis};
+    use host::rayfile::{HitRecord, RayRecord};
+    use host::trace::{median, millis};
     use std::time::Instant;
     use tinybvh_rs::{bvh::BVH, Intersection, Intersector, Ray, INFINITE};
 

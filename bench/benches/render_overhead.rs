@@ -1,14 +1,14 @@
-//! Criterion view of `host::bench::overhead`: the renderer against hand-written casters doing
+//! Criterion view of `raykernel_bench::overhead`: the renderer against hand-written casters doing
 //! the same work (`primary`: no effect used, emissive objects, no lights; `shadow`: one point
 //! light and shadow rays), single thread, 256×256, a 20,480-triangle icosphere on a floor.
-//! `host bench` reports the same comparison as medians of interleaved runs.
+//! `raykernel-bench` reports the same comparison as medians of interleaved runs.
 //!
-//! `cargo bench -p raykernel-host --bench render_overhead`.
+//! `cargo bench -p raykernel-bench --bench render_overhead`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use host::bench::overhead::{with_fixture, Workload, SIZE};
 use raykernel::spawn::SpawnScalar;
 use raykernel::I16F16;
+use raykernel_bench::overhead::{with_fixture, Workload, SIZE};
 
 fn bench_mode<S: SpawnScalar>(c: &mut Criterion) {
     let len = (3 * SIZE * SIZE) as usize;

@@ -1,4 +1,5 @@
-//! Records the compiler that builds the host, for the benchmark report's machine line.
+//! Records the compiler that builds the benchmark, for the report's machine line; with the
+//! `embree` feature, compiles the Embree shim (C) and links the system's libembree3.
 use std::process::Command;
 
 fn main() {
@@ -12,4 +13,12 @@ fn main() {
     println!("cargo:rustc-env=HOST_RUSTC_VERSION={}", version.trim());
     println!("cargo:rerun-if-env-changed=RUSTC");
     println!("cargo:rerun-if-changed=build.rs");
+    if std::env::var_os("CARGO_FEATURE_EMBREE").is_some() {
+        println!("cargo:rerun-if-changed=csrc/embree_shim.c");
+        cc::Build::new()
+            .file("csrc/embree_shim.c")
+            .warnings(true)
+            .compile("rkb_embree_shim");
+        println!("cargo:rustc-link-lib=embree3");
+    }
 }

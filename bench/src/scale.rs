@@ -9,13 +9,13 @@
 //! the `city` file), and the last instance is cut so the instances hold exactly the target
 //! count. Rays: primary from that camera, incoherent from SplitMix64 in the scene box.
 
-use super::ours::mrays;
-use super::results::ScaleRow;
-use super::workload::{incoherent_rays, primary_rays, side_for, SplitMix64};
 use crate::error::Error;
-use crate::obj::Mesh;
-use crate::scene::PinholeCamera;
-use crate::trace::{
+use crate::ours::mrays;
+use crate::results::ScaleRow;
+use crate::workload::{incoherent_rays, primary_rays, side_for, SplitMix64};
+use host::obj::Mesh;
+use host::scene::PinholeCamera;
+use host::trace::{
     build_and_visit, median, prepare_rays, trace_closest, AccelConfig, AccelKind, AccelVisitor,
     Mode, NodeArena, PreparedRays,
 };
@@ -49,7 +49,7 @@ struct Source<'m> {
 
 impl<'m> Source<'m> {
     fn new(mesh: &'m Mesh) -> Option<Self> {
-        let (lo, hi) = super::workload::referenced_bounds(mesh);
+        let (lo, hi) = crate::workload::referenced_bounds(mesh);
         let (cx, cz) = ((lo[0] + hi[0]) * 0.5, (lo[2] + hi[2]) * 0.5);
         let mut radius: f64 = 0.0;
         for t in &mesh.triangles {
@@ -191,7 +191,7 @@ pub fn run(meshes: &[&Mesh], opts: &ScaleOptions) -> Result<Vec<ScaleRow>, Error
             tiled.instances
         );
         let primary = primary_rays(&tiled.camera, side_for(opts.rays));
-        let (lo, hi) = super::workload::referenced_bounds(&tiled.mesh);
+        let (lo, hi) = crate::workload::referenced_bounds(&tiled.mesh);
         let incoherent = incoherent_rays(lo, hi, opts.rays, 1);
         let path = Path::new("tiled");
         for mode in Mode::ALL {
@@ -207,8 +207,8 @@ pub fn run(meshes: &[&Mesh], opts: &ScaleOptions) -> Result<Vec<ScaleRow>, Error
 
 fn measure_size<S: Scalar>(
     tiled: &Tiled,
-    primary: &[crate::rayfile::RayRecord],
-    incoherent: &[crate::rayfile::RayRecord],
+    primary: &[host::rayfile::RayRecord],
+    incoherent: &[host::rayfile::RayRecord],
     path: &Path,
     opts: &ScaleOptions,
 ) -> Result<ScaleRow, Error> {

@@ -1,21 +1,33 @@
-//! `host bench`: speed and accuracy in one run, with peers, on the shared scenes.
+//! raykernel's benchmark (`raykernel-bench`): speed and accuracy in one run, with peers, on
+//! the shared scenes and the 1.2M-triangle tiled city.
 //!
-//! - [`workload`]: scenes and the WORKLOAD.md ray sets (files from `make_rays.py`, or generated),
+//! - [`cli`]: the command line,
+//! - [`workload`]: scenes and the WORKLOAD.md ray sets (files from `make_rays.py`, or
+//!   generated), the city from `make_tiled.py`,
 //! - [`ours`]: the kernel's contenders (every accelerator, builder and mode, plus the
-//!   benchmark-only Möller–Trumbore contrast of [`mt`]),
-//! - [`peers`]: `obvhs` (BVH2, CWBVH) and `bvh`, measured in the same run,
-//! - [`rounds`]: the headline contender and tinybvh's BVH2 traced in alternation, round by
+//!   benchmark-only Möller–Trumbore contrast of [`mt`]); the headline figure constructs each
+//!   ray from its record inside the timed loop, the pre-built figure beside it does not,
+//! - [`peers`]: Embree 3 (HIGH and MEDIUM, `embree` feature, through [`embree`]), tinybvh
+//!   (`tinybvh` feature), `obvhs` (BVH2, CWBVH) and `bvh`, measured in the same run,
+//! - [`rounds`]: the headline contender, Embree and tinybvh traced in alternation, round by
 //!   round,
 //! - [`accuracy`]: the `f64` reference and each contender's hit-distance error,
 //! - [`scale`]: the tiled scene from 10k to 1M+ triangles,
 //! - [`images`]: the renderer's image error against time, per sampler,
 //! - [`overhead`]: the renderer against hand-written casters (the render plan's cost),
-//! - [`report`], [`plot`], [`stats`]: Markdown, CSV, JSON and PNG output,
-//! - [`machine`]: the machine line.
+//! - [`report`], [`figures`], [`plot`], [`stats`]: Markdown, CSV, JSON and PNG output,
+//! - [`machine`]: the machine line,
+//! - [`error`]: why a run stopped.
 //!
-//! Everything is single-threaded except the untimed `f64` reference.
+//! Everything timed is single-threaded; only the untimed `f64` reference uses every core.
+#![deny(unsafe_code)]
 
 pub mod accuracy;
+pub mod cli;
+#[cfg(feature = "embree")]
+pub mod embree;
+pub mod error;
+pub mod figures;
 pub mod images;
 pub mod machine;
 pub mod mt;
@@ -30,12 +42,21 @@ pub mod scale;
 pub mod stats;
 pub mod workload;
 
-use crate::compare::{compare_hits, DEFAULT_REL};
 use crate::error::Error;
+use host::compare::{compare_hits, DEFAULT_REL};
 use report::{BenchResults, ReferenceRow, Written};
+use results::HitMissSplit;
 use std::path::PathBuf;
 use std::time::Instant;
 use workload::RaySource;
+
+/// The optional peers this build has (cargo features), for the report's command line.
+pub const FEATURES: &[&str] = &[
+    #[cfg(feature = "embree")]
+    "embree",
+    #[cfg(feature = "tinybvh")]
+    "tinybvh",
+];
 
 /// What to run.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -44,6 +65,8 @@ pub struct BenchConfig {
     pub scenes_dir: PathBuf,
     /// Scene names.
     pub scenes: Vec<String>,
+    /// Where the tiled city is kept (made there when absent); `None`: no city.
+    pub city_dir: Option<PathBuf>,
     /// Where the rays come from.
     pub rays: RaySource,
     /// Output directory: `BENCHMARKS.md`, `data.csv`, `data.json`, `plots/`.
@@ -78,7 +101,11 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
     let runs = config.runs.max(1);
     let opts = ours::RunOptions { stride, runs };
     eprintln!("bench: {}", machine.line());
-    let scenes = workload::load_scenes(&config.scenes_dir, &config.scenes, &config.rays)?;
+    let mut scenes = workload::load_scenes(&config.scenes_dir, &config.scenes, &config.rays)?;
+    if let Some(dir) = &config.city_dir {
+        eprintln!("bench: the tiled city ({})", dir.display());
+        scenes.push(workload::load_city(&config.scenes_dir, dir, &config.rays)?);
+    }
     let threads = machine.cores.max(1);
     // Warm-up, untimed: the reference configuration once on the first ray set. Without it the
     // first figure of a run came out 10–20% below the same configuration measured later in
@@ -117,7 +144,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
                 round_rows.push(rounds::run(scene, set, opts, config.rounds, config.peers)?);
             }
             let reference = accuracy::Reference::compute(&tris, &set.records, stride, threads)
-                .map_err(|source| Error::Build {
+                .map_err(|source| host::Error::Build {
                     scene: scene.path.clone(),
                     source,
                 })?;
@@ -136,6 +163,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
                 row.accuracy = Some(reference.accuracy(&row.hit_records));
                 if !row.ours {
                     row.vs_ours = Some(compare_hits(&ours_hits, &row.hit_records, DEFAULT_REL));
+                    row.hitmiss_split = Some(HitMissSplit::of(&ours_hits, &row.hit_records));
                 }
                 // The hits have served; a full run would otherwise keep ~100 MB per set.
                 row.hit_records = Vec::new();
@@ -146,7 +174,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
     let scale_rows = if config.scale.sizes.is_empty() {
         Vec::new()
     } else {
-        let meshes: Vec<&crate::obj::Mesh> = scenes.iter().map(|s| &s.mesh).collect();
+        let meshes: Vec<&host::obj::Mesh> = scenes.iter().map(|s| &s.mesh).collect();
         scale::run(&meshes, &config.scale)?
     };
     eprintln!("bench: render overhead");
@@ -168,6 +196,15 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
             RaySource::Rust { count } => format!(
                 "{count} rays per set generated in Rust (primary: WORKLOAD.md's camera; \
                  incoherent: SplitMix64, not the files' PCG64 rays)"
+            ),
+        } + &match (&config.city_dir, &config.rays) {
+            (None, _) => String::new(),
+            (Some(_), RaySource::Rust { .. }) => {
+                "; the city from make_tiled.py, its rays generated as the others".into()
+            }
+            (Some(dir), _) => format!(
+                "; the city from make_tiled.py and its rays from make_rays.py in {}",
+                dir.display()
             ),
         },
         rows,

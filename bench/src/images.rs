@@ -6,8 +6,8 @@
 //! where the integrand is smooth.
 
 use crate::error::Error;
-use crate::render::{render, RenderError, RenderOptions};
-use crate::trace::Mode;
+use host::render::{render, RenderError, RenderOptions};
+use host::trace::Mode;
 use raykernel::render::scenes;
 use raykernel::render::{SamplerKind, Settings};
 use serde::Serialize;

@@ -9,12 +9,12 @@
 //! - [`Workload::Shadow`]: a diffuse material and one point light against a caster that also
 //!   casts the shadow ray (the kernel's spawn rule) and shades Lambert.
 //!
-//! `host bench` reports medians of interleaved runs (the overhead as the median of each run's
-//! ratio); `cargo bench -p raykernel-host --bench
-//! render_overhead` measures the same fixtures with criterion.
+//! `raykernel-bench` reports medians of interleaved runs (the overhead as the median of each
+//! run's ratio); `cargo bench -p raykernel-bench --bench render_overhead` measures the same
+//! fixtures with criterion.
 
-use crate::mesh::unit_icosphere;
-use crate::trace::NodeArena;
+use host::mesh::unit_icosphere;
+use host::trace::NodeArena;
 use raykernel::bvh::{nodes_needed, BuildOptions};
 use raykernel::glam::Vec3;
 use raykernel::render::{
@@ -295,9 +295,9 @@ fn measure<S: SpawnScalar>(workload: Workload, runs: usize) -> OverheadRow {
     OverheadRow {
         workload: workload.name().into(),
         mode: S::NAME.into(),
-        bare_ms: crate::trace::median(&bare_ms),
-        renderer_ms: crate::trace::median(&renderer_ms),
-        overhead_pct: (crate::trace::median(&ratios) - 1.0) * 100.0,
+        bare_ms: host::trace::median(&bare_ms),
+        renderer_ms: host::trace::median(&renderer_ms),
+        overhead_pct: (host::trace::median(&ratios) - 1.0) * 100.0,
         differing_bytes: a.iter().zip(&b).filter(|(x, y)| x != y).count(),
     }
 }

@@ -1,19 +1,20 @@
-//! Writing the results: `BENCHMARKS.md` (Markdown report), `data.csv` (one figure per line),
-//! `data.json` (everything, structured) and `plots/*.png`.
+//! Writing the results: `BENCHMARKS.md` (Markdown report), `data.csv` and `data.json`'s
+//! `figures` (one figure per row, [`crate::figures`]), the rest of `data.json` (everything,
+//! structured) and `plots/*.png`.
 
-use super::images::ImageRow;
-use super::machine::Machine;
-use super::overhead::OverheadRow;
-use super::plot::{grouped_bars, loglog, Series};
-use super::results::{ScaleRow, TraceRow};
-use super::rounds::RoundsRow;
-use super::workload::RayKind;
 use crate::error::Error;
+use crate::images::ImageRow;
+use crate::machine::Machine;
+use crate::overhead::OverheadRow;
+use crate::plot::{grouped_bars, loglog, Series};
+use crate::results::{ScaleRow, TraceRow};
+use crate::rounds::RoundsRow;
+use crate::workload::RayKind;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// Everything one `host bench` run measured.
+/// Everything one benchmark run measured.
 #[derive(Clone, Debug, Serialize)]
 pub struct BenchResults {
     /// Machine line data.
@@ -81,6 +82,16 @@ pub struct Written {
     pub json: PathBuf,
     /// The plots.
     pub plots: Vec<PathBuf>,
+    /// Rows of `data.json`'s `figures` (and lines of `data.csv` after its header).
+    pub figures: usize,
+}
+
+/// `data.json`: the long figures first, then every structured result.
+#[derive(Serialize)]
+struct DataJson<'a> {
+    figures: &'a [crate::figures::Figure],
+    #[serde(flatten)]
+    results: &'a BenchResults,
 }
 
 fn io_error(path: &Path, e: &std::io::Error) -> Error {
@@ -98,10 +109,15 @@ pub fn write_all(results: &mut BenchResults, out: &Path) -> Result<Written, Erro
     let plots = draw_plots(results, &plots_dir)?;
     let report = out.join("BENCHMARKS.md");
     std::fs::write(&report, markdown(results)).map_err(|e| io_error(&report, &e))?;
+    let figures = crate::figures::figures(results);
     let csv = out.join("data.csv");
-    std::fs::write(&csv, csv_text(results)).map_err(|e| io_error(&csv, &e))?;
+    std::fs::write(&csv, crate::figures::csv_text(&figures)).map_err(|e| io_error(&csv, &e))?;
     let json = out.join("data.json");
-    let text = serde_json::to_string_pretty(results)
+    let data = DataJson {
+        figures: &figures,
+        results,
+    };
+    let text = serde_json::to_string_pretty(&data)
         .map_err(|e| Error::Bench(format!("cannot encode the results: {e}")))?;
     std::fs::write(&json, text + "\n").map_err(|e| io_error(&json, &e))?;
     Ok(Written {
@@ -109,6 +125,7 @@ pub fn write_all(results: &mut BenchResults, out: &Path) -> Result<Written, Erro
         csv,
         json,
         plots,
+        figures: figures.len(),
     })
 }
 
@@ -409,7 +426,6 @@ pub fn markdown(r: &BenchResults) -> String {
     let _ = writeln!(s);
     headline_section(&mut s, r);
     rounds_section(&mut s, r);
-    quoted_section(&mut s, r);
     ours_section(&mut s, r);
     accelerators_section(&mut s, r);
     peers_section(&mut s, r);
@@ -425,14 +441,22 @@ fn headline_section(s: &mut String, r: &BenchResults) {
     let peers = labels(&r.rows, |x| !x.ours);
     let _ = writeln!(
         s,
-        "## Headline: closest hit, Mrays/s, ours and peers in the same run\n"
+        "## Headline: closest hit per ray, Mrays/s, ours and peers in the same run\n"
     );
     let _ = writeln!(
         s,
-        "Ratios are raykernel `f32` (4-wide BVH collapsed from the SAH BVH, watertight) ÷ peer: above 1 means ours is faster.\n"
+        "What a caller pays per query: raykernel constructs each kernel ray from the record's raw \
+         `f32` origin, direction and interval inside the timed loop, and Embree's \
+         `rtcIntersect1` takes the raw record; the other peers take rays converted ahead, so \
+         their conversion time is added to their trace time. `pre-built` is raykernel tracing \
+         rays constructed ahead (traversal alone). Ours is raykernel `f32`, the 4-wide BVH \
+         collapsed from the SAH BVH, watertight; ratios are ours per ray ÷ peer: above 1 means \
+         ours is faster.\n"
     );
-    let mut head = "| scene | rays | raykernel f32 | raykernel fixed |".to_string();
-    let mut rule = "|---|---|---:|---:|".to_string();
+    let mut head =
+        "| scene | triangles | rays | raykernel f32 | raykernel f32 pre-built | raykernel fixed |"
+            .to_string();
+    let mut rule = "|---|---:|---|---:|---:|---:|".to_string();
     for p in &peers {
         let _ = write!(head, " {p} | ratio |");
         rule.push_str("---:|---:|");
@@ -445,9 +469,11 @@ fn headline_section(s: &mut String, r: &BenchResults) {
             };
             let fixed = fixed_reference(&r.rows, &scene, kind);
             let mut line = format!(
-                "| {scene} | {} | {:.2} | {} |",
+                "| {scene} | {} | {} | {:.2} | {} | {} |",
+                ours.triangles,
                 kind.name(),
                 ours.closest_mrays,
+                opt(ours.closest_mrays_prebuilt, 2),
                 fixed.map_or("-".into(), |f| format!("{:.2}", f.closest_mrays))
             );
             for p in &peers {
@@ -475,122 +501,153 @@ fn headline_section(s: &mut String, r: &BenchResults) {
         "\n![closest hit, primary rays](plots/speed_primary.png)\n\
          ![closest hit, incoherent rays](plots/speed_incoherent.png)\n"
     );
+    any_hit_table(s, r);
+    construction_table(s, r);
+}
+
+fn any_hit_table(s: &mut String, r: &BenchResults) {
+    let embree: Vec<String> = labels(&r.rows, |x| !x.ours && x.contender.starts_with("Embree"));
+    let _ = writeln!(
+        s,
+        "### Any hit per ray, Mrays/s\n\n\
+         `occluded` (the first hit in the interval), ray construction counted as above; timed \
+         once per figure.\n"
+    );
+    let mut head = "| scene | rays | raykernel f32 | raykernel f32 pre-built |".to_string();
+    let mut rule = "|---|---|---:|---:|".to_string();
+    for p in &embree {
+        let _ = write!(head, " {p} | ratio |");
+        rule.push_str("---:|---:|");
+    }
+    let _ = writeln!(s, "{head}\n{rule}");
+    for scene in scenes(&r.rows) {
+        for kind in RayKind::ALL {
+            let Some(ours) = our_reference(&r.rows, &scene, kind) else {
+                continue;
+            };
+            let mut line = format!(
+                "| {scene} | {} | {:.2} | {} |",
+                kind.name(),
+                ours.any_mrays,
+                opt(ours.any_mrays_prebuilt, 2)
+            );
+            for p in &embree {
+                match r
+                    .rows
+                    .iter()
+                    .find(|x| x.scene == scene && x.rays == kind && &x.label() == p)
+                {
+                    Some(x) => {
+                        let _ = write!(
+                            line,
+                            " {:.2} | {} |",
+                            x.any_mrays,
+                            ratio(ours.any_mrays, x.any_mrays)
+                        );
+                    }
+                    None => line.push_str(" - | - |"),
+                }
+            }
+            let _ = writeln!(s, "{line}");
+        }
+    }
+    let _ = writeln!(s);
+}
+
+fn construction_table(s: &mut String, r: &BenchResults) {
+    let _ = writeln!(
+        s,
+        "### Ray construction, ns per ray\n\n\
+         `Ray::from_f32` on every record ahead of tracing (normalisation in `f64`, reciprocals, \
+         shear constants, margins), timed apart: the difference between the per-ray and the \
+         pre-built figures above, measured on its own.\n"
+    );
+    let _ = writeln!(s, "| scene | rays | f32 | fixed |\n|---|---|---:|---:|");
+    for scene in scenes(&r.rows) {
+        for kind in RayKind::ALL {
+            let Some(ours) = our_reference(&r.rows, &scene, kind) else {
+                continue;
+            };
+            let fixed = fixed_reference(&r.rows, &scene, kind);
+            let _ = writeln!(
+                s,
+                "| {scene} | {} | {:.1} | {} |",
+                kind.name(),
+                ours.setup_ns_per_ray,
+                fixed.map_or("-".into(), |f| format!("{:.1}", f.setup_ns_per_ray))
+            );
+        }
+    }
+    let _ = writeln!(s);
 }
 
 fn rounds_section(s: &mut String, r: &BenchResults) {
     let Some(first) = r.rounds.first() else {
         return;
     };
-    let with_peer = r.rounds.iter().any(|x| !x.peer_mrays.is_empty());
+    let with_embree = r.rounds.iter().any(|x| !x.embree_mrays.is_empty());
+    let with_tinybvh = r.rounds.iter().any(|x| !x.tinybvh_mrays.is_empty());
+    let missing: Vec<&str> = [
+        (!with_embree).then_some("Embree (`--features embree`)"),
+        (!with_tinybvh).then_some("tinybvh (`--features tinybvh`)"),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
     let _ = writeln!(
         s,
-        "### Interleaved rounds{}\n\n\
-         Each ray set traced {} times by raykernel `f32` (4-wide BVH, SAH){}, each structure \
-         built once. A slow spell of the machine then slows both contenders of a round, so the \
-         per-round ratio is the robust comparison. `best` is the fastest round: noise from \
-         other tenants only adds time, so it is the figure least disturbed by them (Chen and \
-         Revels 2016). `quoted` is tinybvh's BVH2 figure quoted in the kernel issue.\n",
-        if with_peer {
-            ": raykernel and tinybvh's BVH2, alternating"
-        } else {
-            ""
-        },
+        "### Interleaved rounds\n\n\
+         Each ray set traced {} times in alternation: raykernel `f32` (4-wide BVH, SAH) per \
+         ray, Embree 3 HIGH, raykernel on pre-built rays, tinybvh 1.6's BVH2 on pre-built \
+         rays; each structure built once. A slow spell of the machine then slows every \
+         contender of a round, so the per-round ratio is the robust comparison: ours per ray ÷ \
+         Embree (both pay their ray setup), ours pre-built ÷ tinybvh (neither does). `best` is \
+         the fastest round: noise from other tenants only adds time, so it is the figure least \
+         disturbed by them (Chen and Revels 2016).{}\n",
         first.ours_mrays.len(),
-        if with_peer {
-            " and by tinybvh 1.6's BVH2 in alternation (ours, tinybvh, ours, ...)"
+        if missing.is_empty() {
+            String::new()
         } else {
-            " (tinybvh not in this build: `--features tinybvh`)"
-        },
+            format!(" Not in this build: {}.", missing.join(", "))
+        }
     );
     let _ = writeln!(
         s,
-        "| scene | rays | raykernel median | raykernel best | tinybvh median | tinybvh best | \
-         ours ÷ tinybvh per round: median (min–max) | quoted tinybvh | ours ÷ quoted: median / best |\n\
-         |---|---|---:|---:|---:|---:|---:|---:|---:|"
+        "| scene | rays | pair | ours median | ours best | peer median | peer best | ours ÷ peer per round: median (min–max) |\n\
+         |---|---|---|---:|---:|---:|---:|---:|"
     );
     for x in &r.rounds {
-        let fig = |v: Option<f64>| v.map_or_else(|| "-".into(), |v| format!("{v:.2}"));
-        let ratios = x.ratios();
-        let per_round = if ratios.is_empty() {
-            "-".to_string()
-        } else {
-            let lo = ratios.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = ratios.iter().copied().fold(0.0, f64::max);
-            format!("{:.2}× ({lo:.2}–{hi:.2})", crate::trace::median(&ratios))
-        };
-        let quoted = QUOTED
-            .iter()
-            .find(|q| q.0 == "tinybvh BVH2" && q.1 == x.scene)
-            .map(|q| match x.rays {
-                RayKind::Primary => q.2,
-                RayKind::Incoherent => q.3,
-            });
-        let vs_quoted = quoted.map_or_else(
-            || "-".into(),
-            |q| {
-                format!(
-                    "{} / {}",
-                    ratio(x.ours_median(), q),
-                    ratio(x.ours_best(), q)
-                )
-            },
-        );
-        let _ = writeln!(
-            s,
-            "| {} | {} | {:.2} | {:.2} | {} | {} | {per_round} | {} | {vs_quoted} |",
-            x.scene,
-            x.rays.name(),
-            x.ours_median(),
-            x.ours_best(),
-            fig(x.peer_median()),
-            fig(x.peer_best()),
-            fig(quoted),
-        );
-    }
-    let _ = writeln!(s);
-}
-
-/// Peers' figures quoted in the project brief and the kernel issue (this machine kind, the
-/// shared workload, single thread, closest hit, Mrays/s primary / incoherent): not measured by
-/// this run. `(peer, scene, primary, incoherent)`.
-const QUOTED: [(&str, &str, f64, f64); 6] = [
-    ("Embree 3.13", "bunny", 13.9, 6.2),
-    ("tinybvh BVH2", "bunny", 8.05, 2.51),
-    ("tinybvh BVH2", "sponza", 3.39, 1.62),
-    ("tinybvh BVH2", "kitchen", 4.97, 1.85),
-    ("obvhs BVH2", "bunny", 7.75, 2.68),
-    ("bvh 0.12", "bunny", 2.26, 0.86),
-];
-
-fn quoted_section(s: &mut String, r: &BenchResults) {
-    let ours = |scene, kind| our_reference(&r.rows, scene, kind).map(|x| x.closest_mrays);
-    let _ = writeln!(
-        s,
-        "### Quoted peers\n\n\
-         Figures from the project brief and the kernel issue, measured on this machine kind \
-         with the same workload, so each ratio mixes two runs. Embree is not built here; \
-         tinybvh's BVH2 is also measured in this run when `host` is built with the `tinybvh` \
-         feature (the headline table). Ours: raykernel `f32` 4-wide BVH (collapsed from the \
-         SAH BVH), watertight, from this run.\n"
-    );
-    let _ = writeln!(
-        s,
-        "| peer | scene | primary Mrays/s | incoherent Mrays/s | ours primary | ours incoherent | ours ÷ peer, primary | incoherent |\n\
-         |---|---|---:|---:|---:|---:|---:|---:|"
-    );
-    for (name, scene, qp, qi) in QUOTED {
-        let (Some(p), Some(i)) = (
-            ours(scene, RayKind::Primary),
-            ours(scene, RayKind::Incoherent),
-        ) else {
-            continue;
-        };
-        let _ = writeln!(
-            s,
-            "| {name} (quoted) | {scene} | {qp:.2} | {qi:.2} | {p:.2} | {i:.2} | {} | {} |",
-            ratio(p, qp),
-            ratio(i, qi)
-        );
+        let pairs = [
+            ("per ray ÷ Embree 3 HIGH", x.vs_embree()),
+            ("pre-built ÷ tinybvh BVH2", x.vs_tinybvh()),
+        ];
+        let mut any = false;
+        for (name, pairing) in pairs {
+            let Some(p) = pairing else { continue };
+            any = true;
+            let (lo, hi) = p.ratio_range();
+            let _ = writeln!(
+                s,
+                "| {} | {} | {name} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2}× ({lo:.2}–{hi:.2}) |",
+                x.scene,
+                x.rays.name(),
+                p.ours_median,
+                p.ours_best,
+                p.peer_median,
+                p.peer_best,
+                p.median_ratio(),
+            );
+        }
+        if !any {
+            let _ = writeln!(
+                s,
+                "| {} | {} | ours alone | {:.2} | {:.2} | - | - | - |",
+                x.scene,
+                x.rays.name(),
+                host::trace::median(&x.ours_mrays),
+                x.ours_mrays.iter().copied().fold(0.0, f64::max),
+            );
+        }
     }
     let _ = writeln!(s);
 }
@@ -604,7 +661,9 @@ fn ours_section(s: &mut String, r: &BenchResults) {
         s,
         "BVH leaves of up to {} primitives (`bvh::DEFAULT_LEAF_SIZE`); `bvh4` is the 4-wide BVH \
          collapsed from the BVH of the same builder. `any hit` is `occluded` (first hit in \
-         range), timed once on the last run. Nodes and primitives are counted per closest-hit \
+         range), timed once on the last run. `per ray` constructs each ray from its record in \
+         the timed loop; `pre-built` traces rays constructed ahead (`ray setup ns` each). Nodes \
+         and primitives are counted per closest-hit \
          ray (for `bvh4`, every child box tested counts as a node). Bytes per triangle count \
          the nodes in use and the primitive ids (not the triangles). `MT` is the \
          benchmark-only Möller–Trumbore test on the same tree (a contrast, not part of the \
@@ -613,16 +672,16 @@ fn ours_section(s: &mut String, r: &BenchResults) {
     );
     let _ = writeln!(
         s,
-        "| scene | rays | accel | builder | mode | test | build ms | closest Mrays/s | any-hit Mrays/s | setup ms | nodes/ray | prims/ray | bytes/tri | depth |"
+        "| scene | rays | accel | builder | mode | test | build ms | closest Mrays/s per ray | pre-built | any-hit Mrays/s per ray | pre-built | ray setup ns | nodes/ray | prims/ray | bytes/tri | depth |"
     );
     let _ = writeln!(
         s,
-        "|---|---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---|---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for x in r.rows.iter().filter(|x| x.ours) {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.2} | {:.1} | {} | {} | {:.1} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {:.1} | {:.2} | {} | {:.2} | {} | {:.1} | {} | {} | {:.1} | {} |",
             x.scene,
             x.rays.name(),
             x.contender.trim_start_matches("raykernel "),
@@ -631,8 +690,10 @@ fn ours_section(s: &mut String, r: &BenchResults) {
             x.test,
             x.build_ms,
             x.closest_mrays,
+            opt(x.closest_mrays_prebuilt, 2),
             x.any_mrays,
-            x.setup_ms,
+            opt(x.any_mrays_prebuilt, 2),
+            x.setup_ns_per_ray,
             opt(x.nodes_per_ray, 1),
             opt(x.prims_per_ray, 1),
             x.bytes_per_tri,
@@ -727,52 +788,42 @@ fn accelerators_section(s: &mut String, r: &BenchResults) {
             winner(&figs, |f| f.bytes_per_tri, true),
         ));
     }
-    let _ = writeln!(s, "\nWinners in this run:\n\n{}\n", winners.join("\n"));
-    let _ = writeln!(s, "{ACCELERATORS_VERDICT}\n");
+    let _ = writeln!(
+        s,
+        "\nWinners in this run (per-ray closest-hit figures; build time; memory):\n\n{}\n",
+        winners.join("\n")
+    );
 }
-
-/// When each structure wins: the reading of the committed full run (docs/bench) and of
-/// docs/ACCELERATORS.md; the winners list above it is computed from the run at hand.
-const ACCELERATORS_VERDICT: &str = "**When each wins.** The BVHs are the choice whenever one \
-build serves more than a few tens of thousands of rays: any rendered frame. The 4-wide BVH \
-collapsed from the binary one mostly traces fastest, by the widest margin on incoherent rays; on \
-primary rays the two are close. A single figure on this machine varies by up to 30% \
-between runs (slow and fast spells), so the winners listed above can change from run to run. The \
-SAH BVH traces several times as fast as the grid and the kd-tree (the table above). The \
-uniform grid builds fastest (a counting pass and a fill pass, no sorting) and is the smallest \
-structure; it is the slowest tracer, most of all on primary rays where triangle density is \
-uneven (sponza, kitchen: many triangles crowd a few cells). It wins overall only when a scene is \
-rebuilt for few rays (dynamic geometry traced sparsely). The kd-tree builds slowest (SAH over \
-straddling references) and is the largest; it traces faster than the grid everywhere but far \
-behind the SAH BVH: with this budgeted build it has no niche here beyond being the lecture's \
-other space partition.";
 
 fn peers_section(s: &mut String, r: &BenchResults) {
     let _ = writeln!(s, "## Peers: same triangles, same rays, same run\n");
     let _ = writeln!(
         s,
         "Throughput ratios are ours ÷ peer, build ratio is peer time ÷ our time (both: above \
-         1 means ours is faster); ours is raykernel `f32`, 4-wide BVH from the SAH BVH, watertight. Agreement with our \
+         1 means ours is faster); ours is raykernel `f32`, 4-wide BVH from the SAH BVH, \
+         watertight, per ray (construction counted, as in the headline). Agreement with our \
          hits follows `compare_hits.py` (same prim and |Δt| ≤ 1e-5·t); `ties` = t agrees but \
-         the prim differs; `hit/miss` = one side hits, the other misses. Peers cannot count \
-         nodes visited.\n"
+         the prim differs; `hit/miss` = one side hits, the other misses, split into `only ours` \
+         and `only peer` (the accuracy section says which side the `f64` reference takes). \
+         Bytes per triangle: see Method. Peers cannot count nodes visited.\n"
     );
     let _ = writeln!(
         s,
-        "| scene | rays | peer | build ms | build ratio | closest Mrays/s | ratio | any-hit Mrays/s | ratio | prims/ray | bytes/tri | agree % | ties | hit/miss | hits ours / peer |"
+        "| scene | rays | peer | build ms | build ratio | closest Mrays/s | ratio | pre-built | any-hit Mrays/s | ratio | prims/ray | bytes/tri | agree % | ties | hit/miss | only ours | only peer | hits ours / peer |"
     );
     let _ = writeln!(
         s,
-        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for x in r.rows.iter().filter(|x| !x.ours) {
         let Some(ours) = our_reference(&r.rows, &x.scene, x.rays) else {
             continue;
         };
         let c = x.vs_ours;
+        let split = x.hitmiss_split;
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {:.1} | {} | {:.2} | {} | {:.2} | {} | {} | {:.1} | {} | {} | {} | {} / {} |",
+            "| {} | {} | {} | {:.1} | {} | {:.2} | {} | {} | {:.2} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} / {} |",
             x.scene,
             x.rays.name(),
             x.contender,
@@ -780,6 +831,7 @@ fn peers_section(s: &mut String, r: &BenchResults) {
             ratio(x.build_ms, ours.build_ms),
             x.closest_mrays,
             ratio(ours.closest_mrays, x.closest_mrays),
+            opt(x.closest_mrays_prebuilt, 2),
             x.any_mrays,
             ratio(ours.any_mrays, x.any_mrays),
             opt(x.prims_per_ray, 1),
@@ -787,6 +839,8 @@ fn peers_section(s: &mut String, r: &BenchResults) {
             c.map_or("-".into(), |c| format!("{:.3}", c.agree_pct)),
             c.map_or("-".into(), |c| c.prim_only.to_string()),
             c.map_or("-".into(), |c| c.hitmiss.to_string()),
+            split.map_or("-".into(), |h| h.ours_only.to_string()),
+            split.map_or("-".into(), |h| h.peer_only.to_string()),
             ours.hits,
             x.hits
         );
@@ -863,7 +917,7 @@ fn overhead_section(s: &mut String, r: &BenchResults) {
          `primary`: a scene that uses no effect (1 spp, pinhole, static, no \
          lights, emissive objects) against a bare primary-ray caster (camera ray, closest hit, \
          colour, sRGB); `shadow`: a diffuse scene with one point light against a caster that \
-         also casts the shadow ray and shades Lambert (`host/src/bench/overhead.rs`). \
+         also casts the shadow ray and shades Lambert (`bench/src/overhead.rs`). \
          Differing bytes: the `primary` images must be identical; the `shadow` caster shades \
          in `f32` where the renderer uses `f64` surface points.\n"
     );
@@ -977,135 +1031,34 @@ fn notes_section(s: &mut String) {
         s,
         "## Method\n\n\
          - Build: wall time of the call that turns the triangle array into the structure \
-         that is traversed (ours: `Bvh::build` into a 64-byte aligned arena; obvhs: \
+         that is traversed (ours: `Bvh::build` into a 64-byte aligned arena, then the 4-wide \
+         collapse; Embree: `rtcNewScene`, one triangle geometry over shared vertex and index \
+         buffers, `rtcCommitScene`, on a device made with `threads=1`; obvhs: \
          `build_bvh2_from_tris` / `build_cwbvh_from_tris` with `BvhBuildParams::medium_build()`; \
          bvh: `Bvh::build`; tinybvh: `BVH::Build`, its default binned SAH build, through \
          `tinybvh_rs::bvh::BVH::new`), parsing excluded.\n\
-         - Trace: wall time of tracing every ray and storing `{{t, prim}}`; turning records \
-         into each library's ray type is timed apart (`setup ms`).\n\
-         - Peers' triangle tests: obvhs uses its own two-sided Möller–Trumbore; bvh's \
-         `intersects_triangle` culls back faces, so its rows use this benchmark's two-sided \
-         Möller–Trumbore and its `nearest_traverse_iterator` (boxes in order of entry, stopped \
-         past the best hit); tinybvh traces with its scalar `BVH::Intersect` and its own \
-         Möller–Trumbore (one FFI call per ray; `tinybvh-rs` builds the C++ with \
+         - Trace: wall time of tracing every ray and storing `{{t, prim}}`. Per ray: ours \
+         constructs `Ray::from_f32` from each record inside the loop; Embree gets one \
+         `rtcIntersect1` call per record (origin, direction, tnear = tmin, tfar = tmax as \
+         given) from a C loop in the benchmark's shim; the other peers' conversion to their ray \
+         type is timed apart (`setup`) and added. Pre-built: tracing rays converted ahead.\n\
+         - Peers' triangle tests: Embree its own; obvhs its own two-sided Möller–Trumbore; \
+         bvh's `intersects_triangle` culls back faces, so its rows use this benchmark's \
+         two-sided Möller–Trumbore and its `nearest_traverse_iterator` (boxes in order of \
+         entry, stopped past the best hit); tinybvh traces with its scalar `BVH::Intersect` and \
+         its own Möller–Trumbore (one FFI call per ray; `tinybvh-rs` builds the C++ with \
          `-march=native`), has no occlusion query in `tinybvh-rs` (any hit not measured) and \
-         does not count primitive tests (n/a). Peers' bytes/tri: obvhs and tinybvh nodes + \
-         primitive indices; bvh nodes only.\n\
+         does not count primitive tests (n/a).\n\
+         - Bytes per triangle: ours, the nodes in use and the primitive ids; Embree, what its \
+         device memory monitor reports the build left allocated (its nodes and triangle \
+         copies, counted in the blocks it reserves); obvhs and tinybvh, nodes and primitive \
+         indices; bvh, nodes only. The triangles themselves are not counted.\n\
+         - The city (`make_tiled.py`, 1.2M triangles) runs the headline configurations of ours \
+         only (4-wide BVH from the SAH BVH, both modes), with every peer.\n\
+         - `data.json`'s `figures` holds one row per scene, ray set, contender and figure; \
+         `bench/scripts/ratios.py data.json` recomputes the headline and round ratios from \
+         them.\n\
          - Criterion micro-benchmarks of the hot functions (slab test, triangle test, one \
-         traversal): `cargo bench -p raykernel-host --bench hot`.\n"
+         traversal): `cargo bench -p raykernel-bench --bench hot`.\n"
     );
-}
-
-/// The CSV: one figure per line, `section,scene,rays,contender,builder,test,mode,metric,value`.
-#[must_use]
-pub fn csv_text(r: &BenchResults) -> String {
-    let mut s = String::from("section,scene,rays,contender,builder,test,mode,metric,value\n");
-    let mut line = |section: &str, x: &TraceRow, metric: &str, value: f64| {
-        let _ = writeln!(
-            s,
-            "{section},{},{},{},{},{},{},{metric},{value}",
-            x.scene,
-            x.rays.name(),
-            x.contender,
-            x.builder,
-            x.test,
-            x.mode
-        );
-    };
-    for x in &r.rows {
-        let section = if x.ours { "traversal" } else { "peer" };
-        line(section, x, "rays", x.ray_count as f64);
-        line(section, x, "triangles", x.triangles as f64);
-        line(section, x, "build_ms", x.build_ms);
-        line(section, x, "setup_ms", x.setup_ms);
-        line(section, x, "closest_mrays", x.closest_mrays);
-        line(section, x, "any_mrays", x.any_mrays);
-        if let Some(v) = x.nodes_per_ray {
-            line(section, x, "nodes_per_ray", v);
-        }
-        if let Some(v) = x.prims_per_ray {
-            line(section, x, "prims_per_ray", v);
-        }
-        line(section, x, "bytes_per_tri", x.bytes_per_tri);
-        if let Some(d) = x.depth {
-            line(section, x, "depth", f64::from(d));
-        }
-        line(section, x, "hits", x.hits as f64);
-        line(section, x, "any_hits", x.any_hits as f64);
-        if let Some(c) = x.vs_ours {
-            line("agreement", x, "agree_pct", c.agree_pct);
-            line("agreement", x, "ties", c.prim_only as f64);
-            line("agreement", x, "hitmiss", c.hitmiss as f64);
-        }
-        if let Some(a) = x.accuracy {
-            line("accuracy", x, "t_rel_max", a.t_rel_max);
-            line("accuracy", x, "t_rel_mean", a.t_rel_mean);
-            line("accuracy", x, "wrong_prim", a.wrong_prim as f64);
-            line("accuracy", x, "ties", a.ties as f64);
-            line("accuracy", x, "leaks", a.leaks as f64);
-            line("accuracy", x, "false_hits", a.false_hits as f64);
-        }
-    }
-    for x in &r.rounds {
-        let runs = [
-            ("raykernel bvh4", "sah", &x.ours_mrays),
-            ("tinybvh 1.6 BVH2", "binned SAH", &x.peer_mrays),
-        ];
-        for (contender, builder, figures) in runs {
-            for (k, v) in figures.iter().enumerate() {
-                let _ = writeln!(
-                    s,
-                    "rounds,{},{},{contender},{builder},,f32,closest_mrays_round{},{v}",
-                    x.scene,
-                    x.rays.name(),
-                    k + 1
-                );
-            }
-        }
-    }
-    for x in &r.scale {
-        for (metric, value) in [
-            ("triangles", x.triangles as f64),
-            ("instances", x.instances as f64),
-            ("build_ms", x.build_ms),
-            ("bytes_per_tri", x.bytes_per_tri),
-            ("rays", x.ray_count as f64),
-            ("primary_mrays", x.primary_mrays),
-            ("incoherent_mrays", x.incoherent_mrays),
-            ("incoherent_nodes_per_ray", x.incoherent_nodes_per_ray),
-        ] {
-            let _ = writeln!(
-                s,
-                "scale,tiled-{},,raykernel bvh,{},watertight,{},{metric},{value}",
-                x.triangles, x.builder, x.mode
-            );
-        }
-    }
-    for x in &r.overhead {
-        for (metric, value) in [
-            ("bare_ms", x.bare_ms),
-            ("renderer_ms", x.renderer_ms),
-            ("overhead_pct", x.overhead_pct),
-            ("differing_bytes", x.differing_bytes as f64),
-        ] {
-            let _ = writeln!(
-                s,
-                "overhead,icosphere-256,{},raykernel render,,,{},{metric},{value}",
-                x.workload, x.mode
-            );
-        }
-    }
-    for x in &r.images {
-        for (metric, value) in [("seconds", x.seconds), ("rmse", x.rmse)] {
-            let _ = writeln!(
-                s,
-                "images,{},{}spp,raykernel render,{},,f32,{metric},{value}",
-                x.scene, x.spp, x.sampler
-            );
-        }
-    }
-    for x in &r.slopes {
-        let _ = writeln!(s, "fit,{},,{},,,,slope,{}", x.plot, x.series, x.slope);
-    }
-    s
 }

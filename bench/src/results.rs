@@ -2,16 +2,19 @@
 //! one [`ScaleRow`] per size of the tiled scene. The report, the CSV and the JSON are all
 //! written from these.
 
-use super::accuracy::Accuracy;
-use super::workload::RayKind;
-use crate::compare::Comparison;
-use crate::rayfile::HitRecord;
+use crate::accuracy::Accuracy;
+use crate::workload::RayKind;
+use host::compare::Comparison;
+use host::rayfile::HitRecord;
 use serde::Serialize;
 
 /// Figures of one contender (our kernel in one configuration, or a peer) on one ray set.
 ///
-/// Times are medians over the runs; `closest_mrays` and `any_mrays` count tracing only
-/// (turning records into each contender's ray type is `setup_ms`, timed apart).
+/// Times are medians over the runs. `closest_mrays` and `any_mrays` are the per-ray figures,
+/// what a caller pays: ours and Embree construct each ray from its record inside the timed
+/// loop; the other peers take rays converted ahead, so theirs add that conversion
+/// (`setup_ms`) to the trace time. `*_prebuilt` count tracing of rays built ahead only (ours
+/// and the peers that take pre-built rays; `None` for Embree, whose call takes raw records).
 #[derive(Clone, Debug, Serialize)]
 pub struct TraceRow {
     /// Scene name.
@@ -34,12 +37,18 @@ pub struct TraceRow {
     pub mode: String,
     /// Build wall time, ms.
     pub build_ms: f64,
-    /// Ray setup wall time, ms (records to the contender's ray type).
+    /// Ray setup wall time, ms (records to the contender's ray type, ahead of tracing).
     pub setup_ms: f64,
-    /// Closest hit, million rays per second.
+    /// `setup_ms` per traced ray, ns.
+    pub setup_ns_per_ray: f64,
+    /// Closest hit, million rays per second, ray construction included.
     pub closest_mrays: f64,
-    /// Any hit (occlusion), million rays per second.
+    /// Closest hit of pre-built rays, million rays per second.
+    pub closest_mrays_prebuilt: Option<f64>,
+    /// Any hit (occlusion), million rays per second, ray construction included.
     pub any_mrays: f64,
+    /// Any hit of pre-built rays, million rays per second.
+    pub any_mrays_prebuilt: Option<f64>,
     /// Nodes visited per ray, closest hit (`None` where the contender cannot count them).
     pub nodes_per_ray: Option<f64>,
     /// Primitive tests per ray, closest hit.
@@ -54,6 +63,8 @@ pub struct TraceRow {
     pub any_hits: usize,
     /// Agreement of the closest hits with our reference row (`f32`, watertight, SAH).
     pub vs_ours: Option<Comparison>,
+    /// Of the rays only one side hits: how many only ours hits, how many only this peer.
+    pub hitmiss_split: Option<HitMissSplit>,
     /// Errors against the `f64` reference.
     pub accuracy: Option<Accuracy>,
     /// The closest hits, one per traced ray (kept for the comparisons, not written out).
@@ -66,7 +77,7 @@ impl TraceRow {
     #[must_use]
     pub fn label(&self) -> String {
         if self.ours {
-            let test = if self.test == super::ours::MT_TEST {
+            let test = if self.test == crate::ours::MT_TEST {
                 " MT"
             } else {
                 ""
@@ -82,7 +93,7 @@ impl TraceRow {
     #[must_use]
     pub fn family(&self) -> String {
         if self.ours {
-            if self.test == super::ours::MT_TEST {
+            if self.test == crate::ours::MT_TEST {
                 "raykernel f32 MT".into()
             } else {
                 format!("raykernel {}", self.mode)
@@ -90,6 +101,31 @@ impl TraceRow {
         } else {
             self.contender.clone()
         }
+    }
+}
+
+/// The rays on which exactly one of two hit lists has a hit, by side.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct HitMissSplit {
+    /// Our reference row hits, the peer misses.
+    pub ours_only: usize,
+    /// The peer hits, our reference row misses.
+    pub peer_only: usize,
+}
+
+impl HitMissSplit {
+    /// Counts both sides over two equally long hit lists.
+    #[must_use]
+    pub fn of(ours: &[HitRecord], peer: &[HitRecord]) -> Self {
+        let mut split = Self::default();
+        for (a, b) in ours.iter().zip(peer) {
+            match (a.is_hit(), b.is_hit()) {
+                (true, false) => split.ours_only += 1,
+                (false, true) => split.peer_only += 1,
+                _ => {}
+            }
+        }
+        split
     }
 }
 

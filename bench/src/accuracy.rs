@@ -15,7 +15,7 @@
 //!   the distances agree (shared edges, coincident triangles);
 //! - `leaks`: the reference hits and the contender misses; `false_hits`: the reverse.
 
-use crate::rayfile::{HitRecord, RayRecord};
+use host::rayfile::{HitRecord, RayRecord};
 use raykernel::bvh::{nodes_needed, BuildOptions};
 use raykernel::{Bvh, Node, Triangle};
 use serde::Serialize;

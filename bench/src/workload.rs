@@ -2,9 +2,9 @@
 //! files `shared/bench/make_rays.py` writes, or generated here.
 
 use crate::error::Error;
-use crate::obj::{load_obj, Mesh};
-use crate::rayfile::{read_rays, RayRecord};
-use crate::scene::PinholeCamera;
+use host::obj::{load_obj, Mesh};
+use host::rayfile::{read_rays, RayRecord};
+use host::scene::PinholeCamera;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -139,20 +139,36 @@ pub fn load_scenes(
 
 /// Runs `python3 SCENES/../bench/make_rays.py --scenes-dir SCENES --out OUT NAMES...`.
 fn run_make_rays(scenes_dir: &Path, names: &[String], out: &Path) -> Result<(), Error> {
-    let script = scenes_dir.join("..").join("bench").join("make_rays.py");
-    if !script.is_file() {
-        return Err(Error::Bench(format!(
-            "{} not found: pass --rays DIR (ray files from make_rays.py) or --rust-rays",
+    let mut args = vec![
+        "--scenes-dir".into(),
+        scenes_dir.as_os_str().to_owned(),
+        "--out".into(),
+        out.as_os_str().to_owned(),
+    ];
+    args.extend(names.iter().map(Into::into));
+    let script = script_beside(scenes_dir, "make_rays.py")?;
+    run_python(&script, &args)
+}
+
+/// `SCENES/../bench/NAME`, the shared scripts beside the shared scenes.
+fn script_beside(scenes_dir: &Path, name: &str) -> Result<PathBuf, Error> {
+    let script = scenes_dir.join("..").join("bench").join(name);
+    if script.is_file() {
+        Ok(script)
+    } else {
+        Err(Error::Bench(format!(
+            "{} not found: pass --rays DIR (ray files from make_rays.py) or --rust-rays, \
+             and --no-city",
             script.display()
-        )));
+        )))
     }
+}
+
+/// Runs `python3 SCRIPT ARGS...`, its output shown only if it fails.
+fn run_python(script: &Path, args: &[std::ffi::OsString]) -> Result<(), Error> {
     let output = Command::new("python3")
-        .arg(&script)
-        .arg("--scenes-dir")
-        .arg(scenes_dir)
-        .arg("--out")
-        .arg(out)
-        .args(names)
+        .arg(script)
+        .args(args)
         .output()
         .map_err(|e| Error::Bench(format!("cannot run python3 {}: {e}", script.display())))?;
     if !output.status.success() {
@@ -164,6 +180,67 @@ fn run_make_rays(scenes_dir: &Path, names: &[String], out: &Path) -> Result<(), 
         )));
     }
     Ok(())
+}
+
+/// The tiled city's name (`shared/bench/make_tiled.py`'s default scene).
+pub const CITY: &str = "city";
+
+/// The 1.2M-triangle tiled city of WORKLOAD.md, kept in `city_dir`: `city.obj` and
+/// `city.camera` from `make_tiled.py` (run with its defaults over `scenes_dir` when absent),
+/// and its two ray sets from `make_rays.py` into the same directory (when absent), or
+/// generated in Rust as `source` says.
+///
+/// # Errors
+/// A script that is missing or fails, an unreadable scene or ray file.
+pub fn load_city(
+    scenes_dir: &Path,
+    city_dir: &Path,
+    source: &RaySource,
+) -> Result<BenchScene, Error> {
+    std::fs::create_dir_all(city_dir)
+        .map_err(|e| Error::Bench(format!("cannot create {}: {e}", city_dir.display())))?;
+    let file = |ext: &str| city_dir.join(format!("{CITY}.{ext}"));
+    if !file("obj").is_file() || !file("camera").is_file() {
+        eprintln!("bench: making {} with make_tiled.py", file("obj").display());
+        let script = script_beside(scenes_dir, "make_tiled.py")?;
+        run_python(
+            &script,
+            &[
+                "--scenes-dir".into(),
+                scenes_dir.as_os_str().to_owned(),
+                "--out".into(),
+                city_dir.as_os_str().to_owned(),
+            ],
+        )?;
+    }
+    let rays = match source {
+        RaySource::Rust { count } => RaySource::Rust { count: *count },
+        RaySource::Files(_) | RaySource::MakeRays => {
+            let missing = RayKind::ALL
+                .iter()
+                .any(|k| !file(&format!("{}.rays", k.name())).is_file());
+            if missing {
+                eprintln!("bench: making the city's rays with make_rays.py");
+                // make_rays.py lives beside the shared scenes, not beside the city.
+                let script = script_beside(scenes_dir, "make_rays.py")?;
+                run_python(
+                    &script,
+                    &[
+                        "--scenes-dir".into(),
+                        city_dir.as_os_str().to_owned(),
+                        "--out".into(),
+                        city_dir.as_os_str().to_owned(),
+                        CITY.into(),
+                    ],
+                )?;
+            }
+            RaySource::Files(city_dir.to_path_buf())
+        }
+    };
+    let mut scenes = load_scenes(city_dir, &[CITY.to_string()], &rays)?;
+    scenes
+        .pop()
+        .ok_or_else(|| Error::Bench("the city did not load".into()))
 }
 
 /// A directory under the system's temp dir, removed on drop.

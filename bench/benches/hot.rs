@@ -2,13 +2,13 @@
 //! `slab/<mode>`, `triangle/<test>`, `build/bvh/icosphere5` and `trace/bvh/icosphere5`.
 //! Each checks its answer once before timing (nothing is timed while giving wrong answers).
 //!
-//! `cargo bench -p raykernel-host --bench hot` (criterion is a dev-dependency of the host
+//! `cargo bench -p raykernel-bench --bench hot` (criterion is a dev-dependency of the benchmark
 //! only; the kernel has no dependency on it).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use host::bench::mt::moller_trumbore;
 use raykernel::bvh::{nodes_needed, BuildOptions};
 use raykernel::{Aabb, Accel, Bvh, Node, Ray, Scalar, Triangle, I16F16};
+use raykernel_bench::mt::moller_trumbore;
 use std::hint::black_box;
 
 fn ray<S: Scalar>(o: [f32; 3], d: [f32; 3]) -> Ray<S> {
