@@ -9,7 +9,7 @@ rays=${1:?usage: bench_trace.sh RAYS_DIR [trace flags]}
 shift
 root=$(cd "$(dirname "$0")/../.." && pwd)
 scenes=${SCENES_DIR:-$root/../shared/scenes}
-host=$root/target/release/host
+host=$root/target/release/raykernel
 cargo build --quiet --release -p raykernel-host --manifest-path "$root/Cargo.toml"
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
 echo "machine: $cpu, $(nproc) cores; $(rustc --version); single thread; flags: ${*:-(defaults)}"
