@@ -2,6 +2,7 @@
 //!
 //! Each command returns the JSON object `main` prints as the last line of stdout.
 
+use crate::bake::{run_bake, run_trace_baked, BakeArgs, TraceBakedArgs};
 use crate::check::{check_scene, describe_differences, CaseReport};
 use crate::classify::{classify, Classification};
 use crate::compare::{compare_hits, Comparison, DEFAULT_REL};
@@ -51,6 +52,11 @@ pub enum Command {
     /// Render scenes every way (kernel single-threaded, host tiles at several thread counts
     /// and tile sizes, every accelerator) and check all are byte-identical.
     Check(CheckArgs),
+    /// Build a BVH or 4-wide BVH over an OBJ mesh and write it with its triangles as a baked
+    /// file (docs/BAKED_FORMAT.md), to be loaded in place on a device.
+    Bake(BakeArgs),
+    /// Load a baked file as a device does (all checks, no build) and trace a ray file.
+    TraceBaked(TraceBakedArgs),
 }
 
 /// Settings a command line may override (scene or file settings otherwise).
@@ -468,6 +474,8 @@ pub fn run(cli: &Cli) -> Result<String, Error> {
     let (summary, json) = match &cli.command {
         Command::Trace(args) => (None, serde_json::to_string(&run_trace(args)?)),
         Command::CompareHits(args) => (None, serde_json::to_string(&run_compare(args)?)),
+        Command::Bake(args) => (None, serde_json::to_string(&run_bake(args)?)),
+        Command::TraceBaked(args) => (None, serde_json::to_string(&run_trace_baked(args)?)),
         Command::Bench(args) => (None, serde_json::to_string(&run_bench(args)?)),
         Command::Render(args) => {
             let report = run_render(args)?;

@@ -18,6 +18,7 @@
 //! - [`error`]: the error type `main` turns into a message and an exit code.
 #![forbid(unsafe_code)]
 
+pub mod bake;
 pub mod bench;
 pub mod check;
 pub mod classify;
