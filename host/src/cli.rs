@@ -3,6 +3,7 @@
 //! Each command returns the JSON object `main` prints as the last line of stdout; lines for
 //! people go through a [`Console`] as the work happens.
 
+use crate::bake::{run_bake, run_trace_baked, BakeArgs, TraceBakedArgs};
 use crate::check::{check_scene_with, describe_differences, renders_per_case, CaseReport};
 use crate::classify::{classify, Classification};
 use crate::compare::{compare_hits, Comparison, DEFAULT_REL};
@@ -62,6 +63,11 @@ pub enum Command {
     /// Print a shell completion script, e.g. `raykernel completions bash >
     /// ~/.local/share/bash-completion/completions/raykernel`.
     Completions(CompletionsArgs),
+    /// Build a BVH or 4-wide BVH over an OBJ mesh and write it with its triangles as a baked
+    /// file (docs/BAKED_FORMAT.md), to be loaded in place on a device.
+    Bake(BakeArgs),
+    /// Load a baked file as a device does (all checks, no build) and trace a ray file.
+    TraceBaked(TraceBakedArgs),
 }
 
 /// `raykernel completions SHELL`.
@@ -519,6 +525,8 @@ pub fn run(cli: &Cli, console: &Console) -> Result<String, Error> {
             serde_json::to_string(&report)
         }
         Command::CompareHits(args) => serde_json::to_string(&run_compare(args)?),
+        Command::Bake(args) => serde_json::to_string(&run_bake(args)?),
+        Command::TraceBaked(args) => serde_json::to_string(&run_trace_baked(args)?),
         Command::Render(args) => {
             let job = RenderJob::prepare(args)?;
             console.line(&job.report.plan_line());

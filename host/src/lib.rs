@@ -21,6 +21,7 @@
 //! - [`error`]: the error type `main` turns into a message and an exit code.
 #![forbid(unsafe_code)]
 
+pub mod bake;
 pub mod check;
 pub mod classify;
 pub mod cli;
