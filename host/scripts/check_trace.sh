@@ -85,7 +85,7 @@ for scene in $scenes; do
         for mode in $modes; do
             tag=$scene.$kind.$mode
             for b in $builders; do
-                trace "$tag $b" "$out/$tag.$b.hits" "$obj" "$rays" --mode "$mode" --builder "$b"
+                trace "$tag $b" "$out/$tag.$b.hits" "$obj" "$rays" --mode "$mode" --accel bvh --builder "$b"
             done
             for a in $accels; do
                 trace "$tag $a" "$out/$tag.$a.hits" "$obj" "$rays" --mode "$mode" --accel "$a"
@@ -97,7 +97,7 @@ for scene in $scenes; do
                 --mode "$mode" --accel linear --stride "$stride"
             for b in $builders; do
                 trace "$tag $b /$stride" "$out/$tag.$b.s$stride.hits" "$obj" "$rays" \
-                    --mode "$mode" --builder "$b" --stride "$stride"
+                    --mode "$mode" --accel bvh --builder "$b" --stride "$stride"
                 same "$tag $b == linear (/$stride)" "$out/$tag.$b.s$stride.hits" \
                     "$out/$tag.linear.s$stride.hits"
             done

@@ -3,6 +3,7 @@
 //! Each command returns the JSON object `main` prints as the last line of stdout; lines for
 //! people go through a [`Console`] as the work happens.
 
+use crate::bake::{run_bake, run_trace_baked, BakeArgs, TraceBakedArgs};
 use crate::check::{check_scene_with, describe_differences, renders_per_case, CaseReport};
 use crate::classify::{classify, Classification};
 use crate::compare::{compare_hits, Comparison, DEFAULT_REL};
@@ -52,9 +53,6 @@ pub enum Command {
     /// --scene and --rays, also check each differing ray passes within quantization error of an
     /// edge of a reported triangle.
     CompareHits(CompareArgs),
-    /// Benchmark speed and accuracy on the shared scenes, with peers in the same run; writes
-    /// BENCHMARKS.md, data.csv, data.json and plots/ into --out.
-    Bench(BenchArgs),
     /// Render a scene with the distribution ray tracer: a built-in scene (default `cornell`),
     /// a scene file (.json, see docs/SCENE_FORMAT.md) or an OBJ mesh; PNG out, optionally
     /// linear PFM; parallel over tiles.
@@ -65,6 +63,11 @@ pub enum Command {
     /// Print a shell completion script, e.g. `raykernel completions bash >
     /// ~/.local/share/bash-completion/completions/raykernel`.
     Completions(CompletionsArgs),
+    /// Build a BVH or 4-wide BVH over an OBJ mesh and write it with its triangles as a baked
+    /// file (docs/BAKED_FORMAT.md), to be loaded in place on a device.
+    Bake(BakeArgs),
+    /// Load a baked file as a device does (all checks, no build) and trace a ray file.
+    TraceBaked(TraceBakedArgs),
 }
 
 /// `raykernel completions SHELL`.
@@ -379,8 +382,8 @@ pub struct TraceArgs {
     /// Where to write the hits: 8-byte records `t: f32, prim: u32` per traced ray.
     #[arg(long)]
     pub out: PathBuf,
-    /// Accelerator.
-    #[arg(long, value_enum, default_value_t = AccelKind::Bvh)]
+    /// Accelerator (default: the 4-wide BVH, the fastest to trace).
+    #[arg(long, value_enum, default_value_t = AccelKind::Bvh4)]
     pub accel: AccelKind,
     /// BVH builder.
     #[arg(long, value_enum, default_value_t = Builder::Sah)]
@@ -438,80 +441,6 @@ pub struct CompareReport {
     pub classification: Option<Classification>,
 }
 
-/// `host bench [--quick] [--rays DIR | --rust-rays] [--out DIR] [options]`.
-#[derive(Clone, Debug, Args)]
-pub struct BenchArgs {
-    /// CI smoke test: every 64th ray, one run, scale sweep up to 100k triangles.
-    #[arg(long)]
-    pub quick: bool,
-    /// Directory of the scenes (NAME.obj, NAME.camera).
-    #[arg(long, value_name = "DIR", default_value = "../shared/scenes")]
-    pub scenes: PathBuf,
-    /// Scenes to run (repeatable).
-    #[arg(long = "scene", value_name = "NAME", default_values_t = ["bunny".to_string(), "sponza".to_string(), "kitchen".to_string()])]
-    pub scene_names: Vec<String>,
-    /// Ray files from `make_rays.py --out DIR` [default: run make_rays.py into a temp dir].
-    #[arg(long, value_name = "DIR", conflicts_with = "rust_rays")]
-    pub rays: Option<PathBuf>,
-    /// Generate the rays in Rust instead (primary by WORKLOAD.md's camera formula,
-    /// incoherent from SplitMix64: not the files' rays).
-    #[arg(long)]
-    pub rust_rays: bool,
-    /// Rays per set with --rust-rays.
-    #[arg(long, value_name = "N", default_value_t = 1 << 20,
-          value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
-    pub rays_per_set: usize,
-    /// Output directory.
-    #[arg(long, value_name = "DIR", default_value = "docs/bench")]
-    pub out: PathBuf,
-    /// Trace every K-th ray [default: 1, or 64 with --quick].
-    #[arg(long, value_name = "K", value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
-    pub stride: Option<usize>,
-    /// Runs per figure, medians [default: 3, or 1 with --quick].
-    #[arg(long, value_name = "N", value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
-    pub runs: Option<usize>,
-    /// Skip the peers.
-    #[arg(long)]
-    pub no_peers: bool,
-    /// Interleaved rounds per ray set: the headline contender and tinybvh's BVH2 (with the
-    /// `tinybvh` feature) traced in alternation; `0` skips them [default: 7, or 2 with --quick].
-    #[arg(long, value_name = "N")]
-    pub rounds: Option<usize>,
-    /// Tiled-scene sizes in triangles, comma-separated; `0` skips the sweep
-    /// [default: 10k..2M, or 10k..100k with --quick].
-    #[arg(long, value_name = "N,N,...", value_delimiter = ',')]
-    pub scale: Option<Vec<usize>>,
-    /// Rays per set in the scale sweep [default: 262144, or 16384 with --quick].
-    #[arg(long, value_name = "N", value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
-    pub scale_rays: Option<usize>,
-    /// Skip the image-convergence renders (RMSE against time per sampler).
-    #[arg(long)]
-    pub no_images: bool,
-    /// Largest sample count of the image renders (1, 2, 4, … up to it; the reference uses 16
-    /// times as many) [default: 256, or 16 with --quick].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=65536))]
-    pub image_spp: Option<u32>,
-}
-
-/// The JSON report of `host bench`: where the files went, and the run's size.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct BenchReport {
-    /// The Markdown report.
-    pub report: String,
-    /// The CSV.
-    pub csv: String,
-    /// The JSON.
-    pub json: String,
-    /// PNG plots.
-    pub plots: Vec<String>,
-    /// Trace rows (ours and peers).
-    pub rows: usize,
-    /// Scale rows.
-    pub scale_rows: usize,
-    /// Wall time, seconds.
-    pub elapsed_s: f64,
-}
-
 /// The JSON report of `host trace`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TraceReport {
@@ -521,7 +450,7 @@ pub struct TraceReport {
     pub rays_file: String,
     /// Hit file path.
     pub out: String,
-    /// `bvh`, `linear`, `grid` or `kdtree`.
+    /// `bvh4`, `bvh`, `linear`, `grid` or `kdtree`.
     pub accel: &'static str,
     /// `sah`, `median` or `midpoint`; `null` for linear.
     pub builder: Option<&'static str>,
@@ -541,22 +470,29 @@ pub struct TraceReport {
     pub triangles: usize,
     /// Median wall time of the build, leaf-order permutation included (0 for linear).
     pub build_ms: f64,
-    /// Median wall time of turning records into kernel rays, before tracing.
+    /// Median wall time of constructing each kernel ray from its record and tracing it, one
+    /// record at a time (what a caller pays; no file I/O).
+    pub per_ray_ms: f64,
+    /// Median wall time of turning records into kernel rays, ahead of tracing.
     pub setup_ms: f64,
-    /// Median wall time of tracing and storing every traced ray (no setup, no file I/O).
+    /// Median wall time of tracing and storing every pre-built ray (no setup, no file I/O).
     pub trace_ms: f64,
     /// Build time of each run.
     pub build_ms_runs: Vec<f64>,
-    /// Trace time of each run.
+    /// Per-ray time (construction included) of each run.
+    pub per_ray_ms_runs: Vec<f64>,
+    /// Pre-built trace time of each run.
     pub trace_ms_runs: Vec<f64>,
     /// Rays traced.
     pub rays: usize,
     /// Rays in the file.
     pub rays_in_file: usize,
-    /// Million rays per second of the median trace time.
+    /// Million rays per second, each ray constructed from its record and traced (`per_ray_ms`).
     pub mrays_per_s: f64,
-    /// Million rays per second counting setup as well.
-    pub mrays_per_s_with_setup: f64,
+    /// Million rays per second of tracing pre-built rays (`trace_ms`: construction excluded).
+    pub mrays_per_s_prebuilt: f64,
+    /// Cost of constructing one kernel ray from its record, ns (`setup_ms` per ray).
+    pub setup_ns_per_ray: f64,
     /// Rays that hit.
     pub hits: usize,
     /// Rays the kernel rejected, written as misses.
@@ -589,7 +525,8 @@ pub fn run(cli: &Cli, console: &Console) -> Result<String, Error> {
             serde_json::to_string(&report)
         }
         Command::CompareHits(args) => serde_json::to_string(&run_compare(args)?),
-        Command::Bench(args) => serde_json::to_string(&run_bench(args)?),
+        Command::Bake(args) => serde_json::to_string(&run_bake(args)?),
+        Command::TraceBaked(args) => serde_json::to_string(&run_trace_baked(args)?),
         Command::Render(args) => {
             let job = RenderJob::prepare(args)?;
             console.line(&job.report.plan_line());
@@ -973,14 +910,21 @@ pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
         stride: args.stride,
         triangles: s.triangles,
         build_ms: s.build_ms,
+        per_ray_ms: s.per_ray_ms,
         setup_ms: s.setup_ms,
         trace_ms: s.trace_ms,
         build_ms_runs: s.build_ms_runs,
+        per_ray_ms_runs: s.per_ray_ms_runs,
         trace_ms_runs: s.trace_ms_runs,
         rays: s.rays,
         rays_in_file: rays.len(),
-        mrays_per_s: per_s(s.trace_ms),
-        mrays_per_s_with_setup: per_s(s.trace_ms + s.setup_ms),
+        mrays_per_s: per_s(s.per_ray_ms),
+        mrays_per_s_prebuilt: per_s(s.trace_ms),
+        setup_ns_per_ray: if s.rays > 0 {
+            s.setup_ms * 1e6 / s.rays as f64
+        } else {
+            0.0
+        },
         hits: s.hits,
         bad_rays: s.bad_rays,
         first_bad_ray: first_bad.map(|(i, _)| i),
@@ -1032,67 +976,6 @@ impl TraceReport {
             self.bad_rays, self.rays, self.mode
         ))
     }
-}
-
-/// `host bench`: run the benchmark, write the report, data and plots.
-///
-/// # Errors
-/// Missing inputs (the message says how to get them), bad scene or ray files, a build the
-/// kernel refuses, or an unwritable output directory.
-pub fn run_bench(args: &BenchArgs) -> Result<BenchReport, Error> {
-    use crate::bench::{scale::ScaleOptions, workload::RaySource, BenchConfig};
-    let rays = match (&args.rays, args.rust_rays) {
-        (Some(dir), _) => RaySource::Files(dir.clone()),
-        (None, true) => RaySource::Rust {
-            count: args.rays_per_set,
-        },
-        (None, false) => RaySource::MakeRays,
-    };
-    let sizes = match &args.scale {
-        Some(sizes) => sizes.iter().copied().filter(|&n| n > 0).collect(),
-        None => crate::bench::scale::default_sizes(args.quick),
-    };
-    let config = BenchConfig {
-        scenes_dir: args.scenes.clone(),
-        scenes: args.scene_names.clone(),
-        rays,
-        out: args.out.clone(),
-        stride: args.stride.unwrap_or(if args.quick { 64 } else { 1 }),
-        runs: args.runs.unwrap_or(if args.quick { 1 } else { 3 }),
-        peers: !args.no_peers,
-        rounds: args.rounds.unwrap_or(if args.quick { 2 } else { 7 }),
-        scale: ScaleOptions {
-            sizes,
-            rays: args
-                .scale_rays
-                .unwrap_or(if args.quick { 1 << 14 } else { 1 << 18 }),
-            runs: args.runs.unwrap_or(if args.quick { 1 } else { 3 }),
-        },
-        images: (!args.no_images).then(|| {
-            let threads = std::thread::available_parallelism().map_or(1, usize::from);
-            crate::bench::images::ImageOptions::new(args.quick, args.image_spp, threads)
-        }),
-        quick: args.quick,
-        command: bench_command(),
-    };
-    let (results, written) = crate::bench::run(&config)?;
-    let show = |p: &Path| p.display().to_string();
-    Ok(BenchReport {
-        report: show(&written.report),
-        csv: show(&written.csv),
-        json: show(&written.json),
-        plots: written.plots.iter().map(|p| show(p)).collect(),
-        rows: results.rows.len(),
-        scale_rows: results.scale.len(),
-        elapsed_s: results.elapsed_s,
-    })
-}
-
-/// The command line as typed, with the program shown as `host`.
-fn bench_command() -> String {
-    let mut words: Vec<String> = std::env::args().skip(1).collect();
-    words.insert(0, "host".into());
-    words.join(" ")
 }
 
 /// `host compare-hits`: agreement of OTHER with REF.

@@ -69,8 +69,6 @@ pub enum Error {
         /// Why.
         msg: String,
     },
-    /// `host bench`: a missing input (scenes, ray files, the ray script) or a failed step.
-    Bench(String),
     /// Two hit files to compare hold different numbers of records.
     HitCountMismatch {
         /// The reference file and its record count.
@@ -123,7 +121,6 @@ impl fmt::Display for Error {
             Self::Scene { file, field, msg } if field.is_empty() => write!(f, "{file}: {msg}"),
             Self::Scene { file, field, msg } => write!(f, "{file}: {field}: {msg}"),
             Self::Output { path, msg } => write!(f, "{}: {msg}", path.display()),
-            Self::Bench(msg) => write!(f, "bench: {msg}"),
             Self::HitCountMismatch { reference, other } => write!(
                 f,
                 "hit files differ in length: {} has {} records, {} has {}",
@@ -149,7 +146,6 @@ impl std::error::Error for Error {
             | Self::Scene { .. }
             | Self::Mismatch(_)
             | Self::Output { .. }
-            | Self::Bench(_)
             | Self::HitCountMismatch { .. } => None,
         }
     }

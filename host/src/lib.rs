@@ -15,14 +15,13 @@
 //! - [`render`]: parallel tiles over the kernel's distribution ray tracer, PNG and PFM out,
 //! - [`check`]: every way of rendering gives the same bytes,
 //! - [`snapshot`]: exact comparison with golden images and hashes,
-//! - [`bench`]: `host bench`, speed and accuracy with peers in one run (report, data, plots),
 //! - [`cli`]: the command line (clap) and the commands behind it,
 //! - [`console`]: lines for people (summaries, warnings, progress) apart from the report,
 //! - [`output`]: output files checked and reserved before the work,
 //! - [`error`]: the error type `main` turns into a message and an exit code.
 #![forbid(unsafe_code)]
 
-pub mod bench;
+pub mod bake;
 pub mod check;
 pub mod classify;
 pub mod cli;

@@ -197,7 +197,7 @@ fn records<'b, const N: usize>(
     path: &Path,
     what: &'static str,
 ) -> Result<impl Iterator<Item = &'b [u8; N]>, FileError> {
-    if bytes.len().is_multiple_of(N) {
+    if bytes.len() % N == 0 {
         // Every chunk has N bytes, so the conversion cannot fail.
         Ok(bytes.chunks_exact(N).flat_map(<&[u8; N]>::try_from))
     } else {

@@ -83,6 +83,9 @@ fn trace_prints_a_json_report_as_the_last_line() {
         "trace_ms",
         "rays",
         "mrays_per_s",
+        "per_ray_ms",
+        "mrays_per_s_prebuilt",
+        "setup_ns_per_ray",
         "hits",
         "bad_rays",
         "nodes",
@@ -91,7 +94,7 @@ fn trace_prints_a_json_report_as_the_last_line() {
     ] {
         assert!(v.get(key).is_some(), "{key} missing from {last}");
     }
-    assert_eq!(v["accel"], "bvh");
+    assert_eq!(v["accel"], "bvh4");
     assert_eq!(v["builder"], "sah");
     assert_eq!(v["mode"], "fixed");
     assert_eq!(v["triangles"], 80);
