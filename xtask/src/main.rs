@@ -7,6 +7,12 @@
 //!   on failure, lists the kernel source lines that still reach a panic.
 //! - `cargo xtask size`: the footprint table of the README (code size of a build + traverse
 //!   probe, arena bytes per triangle, stack high-water marks measured on target).
+//! - `cargo xtask determinism`: the golden hashes on every architecture (x86_64, aarch64 under
+//!   qemu-aarch64, wasm32 under Node.js's WASI, RISC-V and the three Cortex-M cores under QEMU)
+//!   and hit files compared with x86_64's; writes the table of docs/PLATFORMS.md
+//!   (`determinism.rs`).
+//! - `cargo xtask speed`: instructions per ray and per pixel on the emulated cores; writes the
+//!   table of docs/PLATFORMS.md (`speed.rs`).
 //! - `cargo xtask bless`: rewrites the goldens: the hash file `tests/golden/kernel_hashes.txt`
 //!   (the kernel's golden test), then the snapshot PNGs `tests/golden/images/` (the host's
 //!   snapshot test, which also checks its renders against the new hashes).
@@ -17,6 +23,9 @@
 #[path = "../../tests/golden/cases.rs"]
 #[allow(dead_code, clippy::all)]
 mod cases;
+mod determinism;
+mod platforms;
+mod speed;
 
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::{Bvh, Node, Triangle};
@@ -65,9 +74,13 @@ fn main() -> ExitCode {
             r.1 == 0
         }
         Some("size") => size(),
+        Some("determinism") => determinism::determinism(),
+        Some("speed") => speed::speed(),
         Some("bless") => bless(),
         _ => {
-            eprintln!("usage: cargo xtask <qemu | panic-check | size | bless>");
+            eprintln!(
+                "usage: cargo xtask <qemu | panic-check | size | determinism | speed | bless>"
+            );
             false
         }
     };
