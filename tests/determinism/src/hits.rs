@@ -8,10 +8,10 @@
 use super::cases::Rng;
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
-use raykernel::kdtree;
+use raykernel::grid::GridOptions;
+use raykernel::kdtree::{self, KdOptions};
 use raykernel::{
-    Accel, Bvh, Bvh4, Grid, GridOptions, KdNode, KdOptions, KdTree, Linear, Node, Node4, Ray,
-    Scalar, Triangle, I16F16,
+    Accel, Bvh, Bvh4, Grid, KdNode, KdTree, Linear, Node, Node4, Ray, Scalar, Triangle, I16F16,
 };
 use std::path::Path;
 

@@ -7,9 +7,9 @@
 
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
-use raykernel::{
-    kdtree, Bvh, Bvh4, Grid, GridOptions, KdNode, KdOptions, KdTree, Linear, Node, Node4, I16F16,
-};
+use raykernel::grid::GridOptions;
+use raykernel::kdtree::KdOptions;
+use raykernel::{kdtree, Bvh, Bvh4, Grid, KdNode, KdTree, Linear, Node, Node4, I16F16};
 use raykernel_baremetal::cases::{self, Bits, Fail, ICO_TRIS};
 use raykernel_baremetal::{exit, golden, known_answers};
 use semihosting::println;
