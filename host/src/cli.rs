@@ -8,18 +8,16 @@ use crate::compare::{compare_hits, Comparison, DEFAULT_REL};
 use crate::error::Error;
 use crate::obj::load_obj;
 use crate::rayfile::{read_hits, read_rays, write_hits};
-use crate::render::{
-    accel_choice, accel_name, mode_name, plan, render, write_pfm, write_png, RenderError,
-    RenderOptions,
-};
+use crate::render::{mode_name, plan, render, write_pfm, write_png, RenderError, RenderOptions};
 use crate::scene::{resolve_scene, DEFAULT_SCENE};
 use crate::scenefile::{write_scene_file, FilterName, SamplerName};
 use crate::spec::{SceneOrigin, SceneSpec};
-use crate::trace::{trace, AccelKind, Builder, Mode, TraceConfig};
+use crate::trace::{accel_parser, trace, Builder, Mode, TraceConfig};
 use clap::builder::RangedU64ValueParser;
 use clap::{Args, Parser, Subcommand};
 use raykernel::bvh::{BuildOptions, BuilderKind, DEFAULT_LEAF_SIZE, MAX_LEAF_SIZE};
 use raykernel::render::{scenes, Settings};
+use raykernel::AccelKind;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -124,7 +122,7 @@ pub struct RenderArgs {
     #[arg(long, value_parser = RangedU64ValueParser::<usize>::new().range(1..=1024))]
     pub threads: Option<usize>,
     /// Accelerator of every object.
-    #[arg(long, value_enum, default_value_t = AccelKind::Bvh)]
+    #[arg(long, default_value = "bvh", value_parser = accel_parser())]
     pub accel: AccelKind,
     /// BVH builder.
     #[arg(long, value_enum, default_value_t = Builder::Sah)]
@@ -269,7 +267,7 @@ pub struct TraceArgs {
     #[arg(long)]
     pub out: PathBuf,
     /// Accelerator.
-    #[arg(long, value_enum, default_value_t = AccelKind::Bvh)]
+    #[arg(long, default_value = "bvh", value_parser = accel_parser())]
     pub accel: AccelKind,
     /// BVH builder.
     #[arg(long, value_enum, default_value_t = Builder::Sah)]
@@ -533,19 +531,11 @@ pub fn run_render(args: &RenderArgs) -> Result<RenderReport, Error> {
     let settings = spec.settings;
     let data = spec.data();
     let mode = args.mode;
-    if args.accel == AccelKind::Bvh4 {
-        return Err(Error::Usage(
-            "--accel bvh4 is for `host trace` only: the renderer has no 4-wide BVH".into(),
-        ));
-    }
-    let accel = accel_choice(
-        args.accel,
-        BuildOptions {
-            builder: args.builder.into(),
-            max_leaf_size: args.leaf,
-            reinsertion: !args.no_reinsertion,
-        },
-    );
+    let accel = args.accel.with_build_options(BuildOptions {
+        builder: args.builder.into(),
+        max_leaf_size: args.leaf,
+        reinsertion: !args.no_reinsertion,
+    });
     let the_plan = plan(&data, settings, mode).map_err(|e| spec.explain(&e, mode_name(mode)))?;
     if let Some(path) = &args.dump_scene {
         write_scene_file(path, &data, &spec.material_names)?;
@@ -563,7 +553,7 @@ pub fn run_render(args: &RenderArgs) -> Result<RenderReport, Error> {
         height: settings.height,
         spp: settings.spp,
         mode: mode_name(mode),
-        accel: accel_name(accel),
+        accel: accel.to_string(),
         triangles: spec.triangles.len(),
         spheres: spec.spheres.len(),
         plan: the_plan.to_string(),
@@ -651,7 +641,7 @@ pub fn run_check(args: &CheckArgs) -> Result<CheckReport, Error> {
 /// # Errors
 /// Bad or unreadable inputs, an unwritable output, or a build the kernel refuses.
 pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
-    let bvh_family = matches!(args.accel, AccelKind::Bvh | AccelKind::Bvh4);
+    let bvh_family = args.accel.permutes_into_leaf_order();
     if args.leaf_order && !bvh_family {
         return Err(Error::Usage(
             "--leaf-order needs --accel bvh or bvh4 (the other accelerators do not permute \
@@ -662,12 +652,11 @@ pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
     let mesh = load_obj(&args.scene)?;
     let rays = read_rays(&args.rays)?;
     let config = TraceConfig {
-        accel: args.accel,
-        build: BuildOptions {
+        accel: args.accel.with_build_options(BuildOptions {
             builder: args.builder.into(),
             max_leaf_size: args.leaf,
             reinsertion: !args.no_reinsertion,
-        },
+        }),
         mode: args.mode,
         stride: args.stride,
         runs: args.runs,

@@ -11,7 +11,7 @@ use crate::error::Error;
 use crate::obj::load_obj;
 use crate::spec::{ObjectSource, SceneOrigin, SceneSpec};
 use raykernel::render::scenes::{ObjectData, SceneData, ShapeRange, SphereData};
-use raykernel::render::{AccelChoice, Camera, Filter, Light, Material, SamplerKind, Settings};
+use raykernel::render::{Camera, Filter, Light, Material, SamplerKind, Settings};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -421,9 +421,14 @@ pub fn parse_scene_file(text: &str, path: &Path) -> Result<SceneSpec, Error> {
 /// # Errors
 /// [`SceneSpec::explain`] of the kernel's error.
 pub fn check_in_kernel(spec: &SceneSpec) -> Result<(), Error> {
-    crate::render::with_renderer::<f32, _>(&spec.data(), spec.settings, AccelChoice::Linear, |_| ())
-        .map(|_| ())
-        .map_err(|e| spec.explain(&e, "f32"))
+    crate::render::with_renderer::<f32, _>(
+        &spec.data(),
+        spec.settings,
+        raykernel::AccelKind::Linear,
+        |_| (),
+    )
+    .map(|_| ())
+    .map_err(|e| spec.explain(&e, "f32"))
 }
 
 /// Turns parsed entries into owned scene data: names to indices, meshes read and placed.

@@ -8,11 +8,13 @@ use super::workload::{BenchScene, RaySet};
 use crate::error::Error;
 use crate::rayfile::HitRecord;
 use crate::trace::{
-    build_and_visit, median, millis, prepare_rays, trace_closest, AccelConfig, AccelKind,
-    AccelVisitor, BuildFigures, Mode, NodeArena, PreparedRays,
+    build_and_visit, median, millis, prepare_rays, trace_closest, AccelConfig, BuildFigures, Mode,
+    NodeArena, PreparedRays,
 };
 use raykernel::bvh::{BuildOptions, BuilderKind};
-use raykernel::{Accel, Primitive, Scalar, TraversalStats, Triangle, I16F16};
+use raykernel::{
+    Accel, AccelKind, AccelVisitor, Primitive, Scalar, TraversalStats, Triangle, I16F16,
+};
 use std::hint::black_box;
 use std::path::Path;
 use std::time::Instant;
@@ -30,7 +32,7 @@ pub struct RunOptions {
 }
 
 /// One configuration of ours.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OurConfig {
     /// Accelerator and builder.
     pub accel: AccelConfig,
@@ -49,18 +51,17 @@ pub fn configs() -> Vec<OurConfig> {
         if accel.is_brute_force() {
             continue;
         }
-        let builders: Vec<BuilderKind> = if accel.uses_builder() {
+        let builders: Vec<BuilderKind> = if accel.build_options().is_some() {
             BuilderKind::ALL.to_vec()
         } else {
             vec![BuilderKind::default()]
         };
         for builder in builders {
             let accel = AccelConfig {
-                accel,
-                build: BuildOptions {
+                accel: accel.with_build_options(BuildOptions {
                     builder,
                     ..BuildOptions::default()
-                },
+                }),
                 leaf_order: false,
             };
             for mode in Mode::ALL {
@@ -70,7 +71,7 @@ pub fn configs() -> Vec<OurConfig> {
                     mt: false,
                 });
             }
-            if accel.accel == AccelKind::Bvh && builder == BuilderKind::default() {
+            if accel.accel == AccelKind::Bvh(BuildOptions::default()) {
                 out.push(OurConfig {
                     accel,
                     mode: Mode::F32,
@@ -125,11 +126,11 @@ pub fn run(scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Result<Vec<Tra
             triangles: tris32.len(),
             ours: true,
             contender: format!("raykernel {}", config.accel.accel.name()),
-            builder: if config.accel.accel.uses_builder() {
-                config.accel.build.builder.name().into()
-            } else {
-                "-".into()
-            },
+            builder: config
+                .accel
+                .accel
+                .build_options()
+                .map_or_else(|| "-".into(), |o| o.builder.name().into()),
             test: if config.mt {
                 MT_TEST.into()
             } else if config.mode == Mode::Fixed {

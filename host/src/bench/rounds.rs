@@ -14,10 +14,9 @@ use super::ours::{mrays, RunOptions};
 use super::workload::{BenchScene, RayKind, RaySet};
 use crate::error::Error;
 use crate::trace::{
-    build_and_visit, median, prepare_rays, trace_closest, AccelConfig, AccelKind, AccelVisitor,
-    NodeArena, PreparedRays,
+    build_and_visit, median, prepare_rays, trace_closest, AccelConfig, NodeArena, PreparedRays,
 };
-use raykernel::Accel;
+use raykernel::{Accel, AccelKind, AccelVisitor};
 use serde::Serialize;
 
 /// One ray set's rounds: Mrays/s of each round, in round order.
@@ -76,8 +75,7 @@ fn best(xs: &[f64]) -> f64 {
 /// The headline configuration: 4-wide BVH, default (SAH) build, no leaf order.
 fn headline_config() -> AccelConfig {
     AccelConfig {
-        accel: AccelKind::Bvh4,
-        build: raykernel::bvh::BuildOptions::default(),
+        accel: AccelKind::Bvh4(raykernel::bvh::BuildOptions::default()),
         leaf_order: false,
     }
 }
