@@ -10,11 +10,12 @@ use host::rayfile::HitRecord;
 use host::rayfile::RayRecord;
 use host::trace::{
     build_and_visit, median, millis, occluded_per_ray, prepare_rays, trace_closest,
-    trace_closest_per_ray, AccelConfig, AccelKind, AccelVisitor, BuildFigures, Mode, NodeArena,
-    PreparedRays,
+    trace_closest_per_ray, AccelConfig, BuildFigures, Mode, NodeArena, PreparedRays,
 };
 use raykernel::bvh::{BuildOptions, BuilderKind};
-use raykernel::{Accel, Primitive, Scalar, TraversalStats, Triangle, I16F16};
+use raykernel::{
+    Accel, AccelKind, AccelVisitor, Primitive, Scalar, TraversalStats, Triangle, I16F16,
+};
 use std::hint::black_box;
 use std::path::Path;
 use std::time::Instant;
@@ -32,7 +33,7 @@ pub struct RunOptions {
 }
 
 /// One configuration of ours.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OurConfig {
     /// Accelerator and builder.
     pub accel: AccelConfig,
@@ -51,18 +52,17 @@ pub fn configs() -> Vec<OurConfig> {
         if accel.is_brute_force() {
             continue;
         }
-        let builders: Vec<BuilderKind> = if accel.uses_builder() {
+        let builders: Vec<BuilderKind> = if accel.build_options().is_some() {
             BuilderKind::ALL.to_vec()
         } else {
             vec![BuilderKind::default()]
         };
         for builder in builders {
             let accel = AccelConfig {
-                accel,
-                build: BuildOptions {
+                accel: accel.with_build_options(BuildOptions {
                     builder,
                     ..BuildOptions::default()
-                },
+                }),
                 leaf_order: false,
             };
             for mode in Mode::ALL {
@@ -72,7 +72,7 @@ pub fn configs() -> Vec<OurConfig> {
                     mt: false,
                 });
             }
-            if accel.accel == AccelKind::Bvh && builder == BuilderKind::default() {
+            if accel.accel == AccelKind::Bvh(BuildOptions::default()) {
                 out.push(OurConfig {
                     accel,
                     mode: Mode::F32,
@@ -99,8 +99,7 @@ pub fn configs_for(triangles: usize) -> Vec<OurConfig> {
     }
     all.into_iter()
         .filter(|c| {
-            c.accel.accel == AccelKind::Bvh4
-                && c.accel.build.builder == BuilderKind::default()
+            matches!(c.accel.accel, AccelKind::Bvh4(b) if b.builder == BuilderKind::default())
                 && !c.mt
         })
         .collect()
@@ -150,11 +149,11 @@ pub fn run(scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Result<Vec<Tra
             triangles: tris32.len(),
             ours: true,
             contender: format!("raykernel {}", config.accel.accel.name()),
-            builder: if config.accel.accel.uses_builder() {
-                config.accel.build.builder.name().into()
-            } else {
-                "-".into()
-            },
+            builder: config
+                .accel
+                .accel
+                .build_options()
+                .map_or_else(|| "-".into(), |o| o.builder.name().into()),
             test: if config.mt {
                 MT_TEST.into()
             } else if config.mode == Mode::Fixed {

@@ -18,11 +18,11 @@ use host::trace::NodeArena;
 use raykernel::bvh::{nodes_needed, BuildOptions};
 use raykernel::glam::Vec3;
 use raykernel::render::{
-    encode_srgb8, AccelChoice, AccelMemory, Camera, Light, Material, Object, ObjectSlot, Renderer,
-    Scene, Settings, Shape,
+    encode_srgb8, Camera, Light, Material, Object, ObjectSlot, RenderMemory, Renderer, Scene,
+    Settings, Shape,
 };
 use raykernel::spawn::{spawn_shadow_ray, SpawnScalar};
-use raykernel::{Accel, Bvh, Ray, Triangle, I16F16};
+use raykernel::{Accel, AccelKind, AccelMemory, Bvh, Ray, Triangle, I16F16};
 use serde::Serialize;
 use std::hint::black_box;
 use std::time::Instant;
@@ -218,14 +218,16 @@ pub fn with_fixture<S: SpawnScalar, R>(
     };
     let mut nodes2 = NodeArena::<S>::with_slots(nodes_needed(tris.len()));
     let mut ids2 = vec![0u32; tris.len()];
-    let mut slots = [ObjectSlot::EMPTY; 1];
-    let memory = AccelMemory {
+    let mut slots = [ObjectSlot::<S>::EMPTY; 1];
+    let memory = RenderMemory {
         objects: &mut slots,
-        bvh_nodes: nodes2.slots(),
-        kd_nodes: &mut [],
-        words: &mut ids2,
+        accel: AccelMemory {
+            nodes: nodes2.slots(),
+            words: &mut ids2,
+            ..AccelMemory::default()
+        },
     };
-    let r = Renderer::new(&scene, settings, AccelChoice::default(), memory)
+    let r = Renderer::new(&scene, settings, AccelKind::default(), memory)
         .expect("the overhead scene is valid");
     let p = r.plan();
     assert!(p.pixel_centre && !p.reflections && !p.lens && !p.motion && p.area_lights == 0);

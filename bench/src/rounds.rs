@@ -19,9 +19,9 @@ use crate::workload::{BenchScene, RayKind, RaySet};
 use host::rayfile::RayRecord;
 use host::trace::{
     build_and_visit, median, prepare_rays, trace_closest, trace_closest_per_ray, AccelConfig,
-    AccelKind, AccelVisitor, NodeArena, PreparedRays,
+    NodeArena, PreparedRays,
 };
-use raykernel::Accel;
+use raykernel::{Accel, AccelKind, AccelVisitor};
 use serde::Serialize;
 
 /// One ray set's rounds: Mrays/s of each contender in each round, in round order (a
@@ -118,8 +118,7 @@ fn best(xs: &[f64]) -> f64 {
 #[must_use]
 pub fn headline_config() -> AccelConfig {
     AccelConfig {
-        accel: AccelKind::Bvh4,
-        build: raykernel::bvh::BuildOptions::default(),
+        accel: AccelKind::Bvh4(raykernel::bvh::BuildOptions::default()),
         leaf_order: false,
     }
 }

@@ -16,11 +16,11 @@ use crate::workload::{incoherent_rays, primary_rays, side_for, SplitMix64};
 use host::obj::Mesh;
 use host::scene::PinholeCamera;
 use host::trace::{
-    build_and_visit, median, prepare_rays, trace_closest, AccelConfig, AccelKind, AccelVisitor,
-    Mode, NodeArena, PreparedRays,
+    build_and_visit, median, prepare_rays, trace_closest, AccelConfig, Mode, NodeArena,
+    PreparedRays,
 };
 use raykernel::bvh::BuildOptions;
-use raykernel::{Accel, Scalar, TraversalStats, I16F16};
+use raykernel::{Accel, AccelKind, AccelVisitor, Scalar, TraversalStats, I16F16};
 use std::hint::black_box;
 use std::path::Path;
 
@@ -218,8 +218,7 @@ fn measure_size<S: Scalar>(
         prepare_rays::<S>(incoherent, 1),
     );
     let config = AccelConfig {
-        accel: AccelKind::Bvh,
-        build: BuildOptions::default(),
+        accel: AccelKind::Bvh(BuildOptions::default()),
         leaf_order: false,
     };
     let mut arena = NodeArena::<S>::for_accel(config.accel, &tris);
@@ -246,7 +245,7 @@ fn measure_size<S: Scalar>(
         triangles: tris.len(),
         instances: tiled.instances,
         mode: S::NAME.into(),
-        builder: config.build.builder.name().into(),
+        builder: BuildOptions::default().builder.name().into(),
         build_ms: median(&builds),
         bytes_per_tri: bytes as f64 / n as f64,
         ray_count: q.rays.len(),

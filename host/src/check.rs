@@ -3,19 +3,15 @@
 //! For each scene and mode, the reference is the kernel's single-threaded whole-image path
 //! ([`raykernel::render::Renderer::render_srgb8`], default BVH). Compared with it, byte for byte:
 //! the host's parallel tiles at 1, 2 and 3 threads and with an odd tile size, and every
-//! accelerator the host knows (brute force; the BVH with each builder at leaf sizes 1 and 4;
-//! the uniform grid; the kd-tree).
+//! accelerator (brute force; the BVH and the 4-wide BVH with each builder at leaf sizes 1 and
+//! 4; the uniform grid; the kd-tree).
 
 use crate::error::Error;
-use crate::render::{
-    accel_choice, accel_name, mode_name, render, render_reference, Image, RenderError,
-    RenderOptions,
-};
+use crate::render::{mode_name, render, render_reference, Image, RenderError, RenderOptions};
 use crate::spec::SceneSpec;
-use crate::trace::{AccelKind, Mode};
-use clap::ValueEnum;
+use crate::trace::Mode;
 use raykernel::bvh::{BuildOptions, BuilderKind};
-use raykernel::render::AccelChoice;
+use raykernel::AccelKind;
 use serde::Serialize;
 
 /// The first pixel where two images differ.
@@ -77,7 +73,7 @@ pub struct Variant {
     /// Tile size.
     pub tile: (u32, u32),
     /// Accelerator.
-    pub accel: AccelChoice,
+    pub accel: AccelKind,
 }
 
 impl Variant {
@@ -90,7 +86,7 @@ impl Variant {
             if self.threads == 1 { "" } else { "s" },
             self.tile.0,
             self.tile.1,
-            accel_name(self.accel)
+            self.accel
         )
     }
 }
@@ -99,7 +95,7 @@ impl Variant {
 /// every accelerator kind (for the BVH: each builder, leaves of 1 and 4) at 2 threads.
 #[must_use]
 pub fn variants() -> Vec<Variant> {
-    let bvh = AccelChoice::default();
+    let bvh = AccelKind::default();
     let mut v: Vec<Variant> = [(1, (16, 16)), (2, (16, 16)), (3, (16, 16)), (2, (7, 5))]
         .into_iter()
         .map(|(threads, tile)| Variant {
@@ -108,29 +104,29 @@ pub fn variants() -> Vec<Variant> {
             accel: bvh,
         })
         .collect();
-    for kind in AccelKind::value_variants() {
-        let builds: Vec<BuildOptions> = match kind {
-            AccelKind::Bvh => [BuilderKind::Sah, BuilderKind::Median, BuilderKind::Midpoint]
+    // Every structure; the BVHs with each builder and leaves of 1 and 4.
+    for kind in AccelKind::ALL {
+        let kinds: Vec<AccelKind> = if kind.build_options().is_some() {
+            BuilderKind::ALL
                 .into_iter()
                 .flat_map(|builder| {
-                    [1, 4].map(|max_leaf_size| BuildOptions {
-                        builder,
-                        max_leaf_size,
-                        reinsertion: true,
+                    [1, 4].map(|max_leaf_size| {
+                        kind.with_build_options(BuildOptions {
+                            builder,
+                            max_leaf_size,
+                            reinsertion: true,
+                        })
                     })
                 })
-                .collect(),
-            AccelKind::Linear | AccelKind::Grid | AccelKind::Kdtree => {
-                vec![BuildOptions::default()]
-            }
-            // Trace only: the renderer has no 4-wide BVH.
-            AccelKind::Bvh4 => Vec::new(),
+                .collect()
+        } else {
+            vec![kind]
         };
-        for build in builds {
+        for accel in kinds {
             v.push(Variant {
                 threads: 2,
                 tile: (16, 16),
-                accel: accel_choice(*kind, build),
+                accel,
             });
         }
     }
@@ -183,7 +179,7 @@ pub fn check_scene_with(
     let data = spec.data();
     let settings = spec.settings;
     let name = mode_name(mode);
-    let reference = render_reference(&data, settings, mode, AccelChoice::default())
+    let reference = render_reference(&data, settings, mode, AccelKind::default())
         .map_err(|e| spec.explain(&e, name))?;
     rendered();
     let mut report = CaseReport {
@@ -269,12 +265,18 @@ mod tests {
     #[test]
     fn variants_cover_threads_tiles_and_every_accelerator() {
         let v = variants();
-        assert!(v.iter().any(|x| x.accel == AccelChoice::Linear));
+        assert!(v.iter().any(|x| x.accel == AccelKind::Linear));
         assert_eq!(
             v.iter()
-                .filter(|x| matches!(x.accel, AccelChoice::Bvh(_)))
+                .filter(|x| matches!(x.accel, AccelKind::Bvh(_)))
                 .count(),
             4 + 6
+        );
+        assert_eq!(
+            v.iter()
+                .filter(|x| matches!(x.accel, AccelKind::Bvh4(_)))
+                .count(),
+            6
         );
         assert!(v.iter().any(|x| x.threads == 3));
         assert!(v.iter().any(|x| x.tile == (7, 5)));

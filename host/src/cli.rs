@@ -13,18 +13,16 @@ use crate::limits::{check_memory, check_settings, render_bytes, MAX_DEPTH, MAX_S
 use crate::obj::{load_obj, point_error_text};
 use crate::output::{Format, Reserved};
 use crate::rayfile::{read_hits, read_rays, write_hits, RayRecord};
-use crate::render::{
-    accel_choice, accel_name, encode_pfm, encode_png, mode_name, plan, render, RenderError,
-    RenderOptions,
-};
+use crate::render::{encode_pfm, encode_png, mode_name, plan, render, RenderError, RenderOptions};
 use crate::scene::{resolve_scene, DEFAULT_SCENE};
 use crate::scenefile::{scene_file_text, spec_to_scene_file, FilterName, SamplerName};
 use crate::spec::{eye_to_look_at, SceneOrigin, SceneSpec};
-use crate::trace::{trace, AccelKind, Builder, Mode, TraceConfig};
+use crate::trace::{accel_parser, trace, Builder, Mode, TraceConfig};
 use clap::builder::RangedU64ValueParser;
 use clap::{Args, CommandFactory, Parser, Subcommand};
 use raykernel::bvh::{BuildOptions, BuilderKind, DEFAULT_LEAF_SIZE, MAX_LEAF_SIZE};
-use raykernel::render::{scenes, AccelChoice, Camera, RenderPlan, Settings};
+use raykernel::render::{scenes, Camera, RenderPlan, Settings};
+use raykernel::AccelKind;
 use raykernel::{Ray, RayError, Scalar, I16F16};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -232,7 +230,7 @@ pub struct RenderArgs {
     #[arg(long, value_parser = RangedU64ValueParser::<usize>::new().range(1..=1024))]
     pub threads: Option<usize>,
     /// Accelerator of every object.
-    #[arg(long, value_enum, default_value_t = AccelKind::Bvh)]
+    #[arg(long, default_value = "bvh", value_parser = accel_parser())]
     pub accel: AccelKind,
     /// BVH builder.
     #[arg(long, value_enum, default_value_t = Builder::Sah)]
@@ -383,7 +381,7 @@ pub struct TraceArgs {
     #[arg(long)]
     pub out: PathBuf,
     /// Accelerator (default: the 4-wide BVH, the fastest to trace).
-    #[arg(long, value_enum, default_value_t = AccelKind::Bvh4)]
+    #[arg(long, default_value = "bvh4", value_parser = accel_parser())]
     pub accel: AccelKind,
     /// BVH builder.
     #[arg(long, value_enum, default_value_t = Builder::Sah)]
@@ -622,7 +620,7 @@ pub fn check_render_request(
 pub struct RenderJob {
     spec: SceneSpec,
     mode: Mode,
-    accel: AccelChoice,
+    accel: AccelKind,
     threads: usize,
     tile: u32,
     out: Option<Reserved>,
@@ -641,11 +639,6 @@ impl RenderJob {
     /// or `.camera` file, settings beyond [`crate::limits`], a scene the kernel rejects in the
     /// chosen mode.
     pub fn prepare(args: &RenderArgs) -> Result<Self, Error> {
-        if args.accel == AccelKind::Bvh4 {
-            return Err(Error::Usage(
-                "--accel bvh4 is for `raykernel trace` only: the renderer has no 4-wide BVH".into(),
-            ));
-        }
         let rendering = !args.explain;
         let out = match &args.out {
             Some(p) if rendering => Some(Reserved::new(p, Format::Png, "--out")?),
@@ -665,14 +658,11 @@ impl RenderJob {
         let mode = args.mode;
         let the_plan = check_render_request(&spec, mode, linear.is_some())?;
         let settings = spec.settings;
-        let accel = accel_choice(
-            args.accel,
-            BuildOptions {
-                builder: args.builder.into(),
-                max_leaf_size: args.leaf,
-                reinsertion: !args.no_reinsertion,
-            },
-        );
+        let accel = args.accel.with_build_options(BuildOptions {
+            builder: args.builder.into(),
+            max_leaf_size: args.leaf,
+            reinsertion: !args.no_reinsertion,
+        });
         if let Some(file) = dump {
             let text = scene_file_text(&spec_to_scene_file(&spec, file.path()));
             file.write(text.as_bytes())?;
@@ -690,7 +680,7 @@ impl RenderJob {
             height: settings.height,
             spp: settings.spp,
             mode: mode_name(mode),
-            accel: accel_name(accel),
+            accel: accel.to_string(),
             triangles: spec.triangles.len(),
             spheres: spec.spheres.len(),
             plan: the_plan.to_string(),
@@ -856,7 +846,7 @@ pub fn run_check_with(args: &CheckArgs, console: &Console) -> Result<CheckReport
 /// # Errors
 /// Bad or unreadable inputs, an unwritable output, or a build the kernel refuses.
 pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
-    let bvh_family = matches!(args.accel, AccelKind::Bvh | AccelKind::Bvh4);
+    let bvh_family = args.accel.permutes_into_leaf_order();
     if args.leaf_order && !bvh_family {
         return Err(Error::Usage(
             "--leaf-order needs --accel bvh or bvh4 (the other accelerators do not permute \
@@ -867,12 +857,11 @@ pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
     let mesh = load_obj(&args.scene)?;
     let rays = read_rays(&args.rays)?;
     let config = TraceConfig {
-        accel: args.accel,
-        build: BuildOptions {
+        accel: args.accel.with_build_options(BuildOptions {
             builder: args.builder.into(),
             max_leaf_size: args.leaf,
             reinsertion: !args.no_reinsertion,
-        },
+        }),
         mode: args.mode,
         stride: args.stride,
         runs: args.runs,

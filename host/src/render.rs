@@ -6,48 +6,19 @@
 //! as the kernel's single-threaded [`Renderer::render_srgb8`] (`host check` proves it).
 
 use crate::error::Error;
-use crate::trace::{AccelKind, Mode, NodeArena};
+use crate::trace::{Mode, NodeArena};
 use indicatif::{ProgressBar, ProgressStyle};
-use raykernel::bvh::BuildOptions;
 use raykernel::render::scenes::SceneData;
 use raykernel::render::{
-    encode_srgb8, memory_needed, AccelChoice, AccelMemory, Object, ObjectSlot, RenderPlan,
-    RenderStats, Renderer, Rgb, SceneError, Settings, Shape, Tile,
+    encode_srgb8, memory_needed, Object, ObjectSlot, RenderMemory, RenderPlan, RenderStats,
+    Renderer, Rgb, SceneError, Settings, Shape, Tile,
 };
 use raykernel::spawn::SpawnScalar;
-use raykernel::{grid::GridOptions, kdtree::KdOptions, KdNode, Scalar, Sphere, Triangle, I16F16};
+use raykernel::{AccelKind, AnyFamily, Scalar, Sphere, Triangle, I16F16};
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
-
-/// The kernel's accelerator for an [`AccelKind`] chosen on the command line (`build` applies to
-/// the BVH; the grid and the kd-tree use their defaults).
-#[must_use]
-pub fn accel_choice(kind: AccelKind, build: BuildOptions) -> AccelChoice {
-    match kind {
-        AccelKind::Bvh => AccelChoice::Bvh(build),
-        AccelKind::Linear => AccelChoice::Linear,
-        AccelKind::Grid => AccelChoice::Grid(GridOptions::default()),
-        AccelKind::Kdtree => AccelChoice::KdTree(KdOptions::default()),
-        // The renderer has no 4-wide BVH (`host render` refuses it); the BVH it is collapsed
-        // from gives the same image bits.
-        AccelKind::Bvh4 => AccelChoice::Bvh(build),
-    }
-}
-
-/// A short name of an accelerator choice: `linear`, `bvh sah leaf 4`, `grid density 2`,
-/// `kdtree depth auto`.
-#[must_use]
-pub fn accel_name(a: AccelChoice) -> String {
-    match a {
-        AccelChoice::Linear => "linear".into(),
-        AccelChoice::Bvh(o) => format!("bvh {} leaf {}", o.builder.name(), o.max_leaf_size),
-        AccelChoice::Grid(o) => format!("grid density {}", o.density),
-        AccelChoice::KdTree(o) if o.max_depth == 0 => "kdtree depth auto".into(),
-        AccelChoice::KdTree(o) => format!("kdtree depth {}", o.max_depth),
-    }
-}
 
 /// How to render (the scene and its settings come separately).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,7 +26,7 @@ pub struct RenderOptions {
     /// Number mode of the geometry.
     pub mode: Mode,
     /// Accelerator of every object.
-    pub accel: AccelChoice,
+    pub accel: AccelKind,
     /// Worker threads (at least 1).
     pub threads: usize,
     /// Tile width and height in pixels (at least 1 each).
@@ -68,7 +39,7 @@ impl Default for RenderOptions {
     fn default() -> Self {
         Self {
             mode: Mode::F32,
-            accel: AccelChoice::default(),
+            accel: AccelKind::default(),
             threads: 1,
             tile: (16, 16),
             progress: false,
@@ -138,7 +109,7 @@ pub struct Rendered {
 pub fn with_renderer<S: SpawnScalar, R>(
     data: &SceneData<'_>,
     settings: Settings,
-    accel: AccelChoice,
+    accel: AccelKind,
     f: impl for<'r> FnOnce(&Renderer<'r, S>) -> R,
 ) -> Result<(R, f64), SceneError> {
     let start = Instant::now();
@@ -159,17 +130,13 @@ pub fn with_renderer<S: SpawnScalar, R>(
     data.spheres_into(&mut spheres)?;
     let mut objects = vec![Object::new(Shape::Triangles(&[]), 0); data.objects.len()];
     let scene = data.scene(&triangles, &spheres, &mut objects)?;
-    let need = memory_needed(scene.objects, accel);
+    let need = memory_needed::<S, AnyFamily>(scene.objects, &accel);
     let mut slots = vec![ObjectSlot::EMPTY; need.objects];
-    // 64-byte aligned, a sibling pair per cache line, as the kernel's layout intends.
-    let mut bvh_nodes = NodeArena::<S>::with_slots(need.bvh_nodes);
-    let mut kd_nodes = vec![KdNode::<S>::EMPTY; need.kd_nodes];
-    let mut words = vec![0u32; need.words];
-    let memory = AccelMemory {
+    // 64-byte aligned BVH nodes, a sibling pair per cache line, as the kernel's layout intends.
+    let mut arena = NodeArena::<S>::sized(need.accel);
+    let memory = RenderMemory {
         objects: &mut slots,
-        bvh_nodes: bvh_nodes.slots(),
-        kd_nodes: &mut kd_nodes,
-        words: &mut words,
+        accel: arena.memory(),
     };
     let renderer = Renderer::new(&scene, settings, accel, memory)?;
     let build_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -186,7 +153,7 @@ pub fn plan(
     mode: Mode,
 ) -> Result<RenderPlan, SceneError> {
     fn go<S: SpawnScalar>(d: &SceneData<'_>, s: Settings) -> Result<RenderPlan, SceneError> {
-        with_renderer::<S, _>(d, s, AccelChoice::Linear, |r| *r.plan()).map(|(p, _)| p)
+        with_renderer::<S, _>(d, s, AccelKind::Linear, |r| *r.plan()).map(|(p, _)| p)
     }
     match mode {
         Mode::F32 => go::<f32>(data, settings),
@@ -324,12 +291,12 @@ pub fn render_reference(
     data: &SceneData<'_>,
     settings: Settings,
     mode: Mode,
-    accel: AccelChoice,
+    accel: AccelKind,
 ) -> Result<Image, SceneError> {
     fn go<S: SpawnScalar>(
         d: &SceneData<'_>,
         s: Settings,
-        a: AccelChoice,
+        a: AccelKind,
     ) -> Result<Image, SceneError> {
         let mut rgb = vec![0u8; 3 * s.width as usize * s.height as usize];
         with_renderer::<S, _>(d, s, a, |r| r.render_srgb8(&mut rgb))?.0?;

@@ -19,7 +19,7 @@ use crate::obj::load_obj;
 use crate::spec::{eye_to_look_at, ObjectSource, SceneOrigin, SceneSpec};
 use raykernel::render::scenes::{ObjectData, SceneData, ShapeRange, SphereData};
 use raykernel::render::MAX_LIGHTS;
-use raykernel::render::{AccelChoice, Camera, Filter, Light, Material, SamplerKind, Settings};
+use raykernel::render::{Camera, Filter, Light, Material, SamplerKind, Settings};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::HashMap;
@@ -494,9 +494,14 @@ fn check_lists(file: &SceneFile) -> Result<(), OverLimit> {
 /// [`SceneSpec::explain`] of the kernel's error.
 pub fn check_in_kernel(spec: &SceneSpec) -> Result<(), Error> {
     spec.check_camera("f32")?;
-    crate::render::with_renderer::<f32, _>(&spec.data(), spec.settings, AccelChoice::Linear, |_| ())
-        .map(|_| ())
-        .map_err(|e| spec.explain(&e, "f32"))
+    crate::render::with_renderer::<f32, _>(
+        &spec.data(),
+        spec.settings,
+        raykernel::AccelKind::Linear,
+        |_| (),
+    )
+    .map(|_| ())
+    .map_err(|e| spec.explain(&e, "f32"))
 }
 
 /// Turns parsed entries into owned scene data: names to indices, meshes read and placed.

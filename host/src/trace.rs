@@ -3,10 +3,10 @@
 //! [`Mode`].
 //!
 //! The pieces are public so the benchmark reuses them rather than copying the loop:
-//! [`build_and_visit`] builds whichever [`AccelKind`] is asked for (timed) and hands it to an
-//! [`AccelVisitor`]; [`trace_closest_per_ray`] times queries that construct each ray from its
-//! record, [`prepare_rays`] and [`trace_closest`] the two halves of a trace of pre-built rays.
-//! A new accelerator is a new [`AccelKind`] variant plus one arm in [`build_and_visit`].
+//! [`build_and_visit`] builds whichever kernel [`AccelKind`] is asked for (timed, through
+//! [`AnyAccel`]) and hands the structure itself to an [`AccelVisitor`];
+//! [`trace_closest_per_ray`] times queries that construct each ray from its record,
+//! [`prepare_rays`] and [`trace_closest`] the two halves of a trace of pre-built rays.
 //!
 //! [`AccelKind::Bvh4`] builds the BVH (timed) and collapses it into the 4-wide tree (timed
 //! too); the BVH's node arena is build scratch, so its figures count only the wide nodes and
@@ -15,65 +15,21 @@
 use crate::error::Error;
 use crate::obj::Mesh;
 use crate::rayfile::{HitRecord, RayRecord};
-use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
-use raykernel::bvh4::nodes4_needed;
+use raykernel::bvh::BuilderKind;
 use raykernel::{
-    grid::GridOptions, kdtree, kdtree::KdOptions, Accel, Bvh, Bvh4, Grid, KdNode, KdTree, Linear,
-    Node, Node4, Primitive, Ray, Scalar, Triangle, I16F16,
+    Accel, AccelKind, AccelMemory, AccelVisitor, AnyAccel, KdNode, Node, Node4, Primitive, Ray,
+    Scalar, Triangle, I16F16,
 };
 use std::path::Path;
 use std::time::Instant;
 
-/// Which accelerator answers the queries.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum AccelKind {
-    /// The kernel's BVH.
-    Bvh,
-    /// Brute force over every triangle: the reference.
-    Linear,
-    /// The kernel's uniform grid (default density).
-    Grid,
-    /// The kernel's kd-tree (SAH, automatic depth).
-    Kdtree,
-    /// The kernel's 4-wide BVH, collapsed from the BVH (same builder options). Trace and
-    /// benchmark only: the renderer has no 4-wide BVH.
-    Bvh4,
-}
-
-impl AccelKind {
-    /// Every accelerator the benchmark compares. The first is the benchmark's reference for
-    /// the peers: the fastest (the 4-wide BVH).
-    pub const ALL: [AccelKind; 5] = [
-        Self::Bvh4,
-        Self::Bvh,
-        Self::Linear,
-        Self::Grid,
-        Self::Kdtree,
-    ];
-
-    /// True for brute force, the reference: too slow for whole benchmark ray sets.
-    #[must_use]
-    pub fn is_brute_force(self) -> bool {
-        matches!(self, Self::Linear)
-    }
-
-    /// True if the build takes a [`BuilderKind`] (otherwise the builder is ignored).
-    #[must_use]
-    pub fn uses_builder(self) -> bool {
-        matches!(self, Self::Bvh | Self::Bvh4)
-    }
-
-    /// Name as on the command line.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Bvh => "bvh",
-            Self::Linear => "linear",
-            Self::Grid => "grid",
-            Self::Kdtree => "kdtree",
-            Self::Bvh4 => "bvh4",
-        }
-    }
+/// Parses `--accel` into the kernel's [`AccelKind`] (default options) by its names, which
+/// the help lists.
+#[must_use]
+pub fn accel_parser() -> impl clap::builder::TypedValueParser<Value = AccelKind> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(AccelKind::ALL.map(|k| k.name()))
+        .map(|name: String| AccelKind::from_name(&name).unwrap_or_default())
 }
 
 /// The kernel's number mode.
@@ -121,12 +77,10 @@ impl From<Builder> for BuilderKind {
 }
 
 /// What to build and which rays to trace.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TraceConfig {
-    /// Accelerator.
+    /// Accelerator and its options.
     pub accel: AccelKind,
-    /// BVH builder and leaf size (ignored by [`AccelKind::Linear`]).
-    pub build: BuildOptions,
     /// Number mode.
     pub mode: Mode,
     /// Trace rays `0, stride, 2·stride, ...` only. Must be at least 1.
@@ -144,20 +98,18 @@ impl TraceConfig {
     pub fn accel_config(&self) -> AccelConfig {
         AccelConfig {
             accel: self.accel,
-            build: self.build,
             leaf_order: self.leaf_order,
         }
     }
 }
 
-/// What to build: accelerator, builder settings, leaf order.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// What to build: accelerator with its options, leaf order.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AccelConfig {
-    /// Accelerator.
+    /// Accelerator and its options.
     pub accel: AccelKind,
-    /// Builder and leaf size (ignored unless [`AccelKind::uses_builder`]).
-    pub build: BuildOptions,
-    /// Permute the primitives into leaf order (BVH and 4-wide BVH only).
+    /// Permute the primitives into leaf order (only the structures that
+    /// [`AccelKind::permutes_into_leaf_order`]).
     pub leaf_order: bool,
 }
 
@@ -172,15 +124,6 @@ pub struct BuildFigures {
     pub accel_bytes: usize,
     /// Depth of the deepest leaf (0 for brute force).
     pub depth: u32,
-}
-
-/// Something to do with a freshly built accelerator (trace rays, count work...). A trait
-/// rather than a closure because it is generic over the accelerator type.
-pub trait AccelVisitor<S: Scalar> {
-    /// What the visit returns.
-    type Output;
-    /// Called once with the built accelerator.
-    fn visit<A: Accel<S>>(self, accel: &A) -> Self::Output;
 }
 
 /// Figures of a trace: times are the medians over the runs.
@@ -353,93 +296,33 @@ pub fn build_and_visit<S: Scalar, P: Primitive<S> + Copy, V: AccelVisitor<S>>(
         scene: scene.to_path_buf(),
         source,
     };
-    match config.accel {
-        AccelKind::Linear => Ok((BuildFigures::default(), visitor.visit(&Linear::new(prims)))),
-        AccelKind::Bvh if config.leaf_order => {
-            // The permutation works in place: give it a fresh copy (untimed, like parsing).
-            let mut own = prims.to_vec();
-            let mut ids = vec![0u32; prims.len()];
-            let start = Instant::now();
-            let bvh = Bvh::build_in_leaf_order(&mut own, arena.slots(), &mut ids, config.build)
-                .map_err(build_error)?;
-            let build_ms = millis(start);
-            Ok((bvh_figures(&bvh, build_ms), visitor.visit(&bvh)))
-        }
-        AccelKind::Bvh => {
-            let mut ids = vec![0u32; prims.len()];
-            let start = Instant::now();
-            let bvh =
-                Bvh::build(prims, arena.slots(), &mut ids, config.build).map_err(build_error)?;
-            let build_ms = millis(start);
-            Ok((bvh_figures(&bvh, build_ms), visitor.visit(&bvh)))
-        }
-        AccelKind::Bvh4 => {
-            // As the BVH arms (leaf order on a fresh copy, untimed), then the collapse.
-            let mut own = if config.leaf_order {
-                prims.to_vec()
-            } else {
-                Vec::new()
-            };
-            let mut ids = vec![0u32; prims.len()];
-            let (nodes, nodes4) = arena.bvh4_slots();
-            let start = Instant::now();
-            let bvh = if config.leaf_order {
-                Bvh::build_in_leaf_order(&mut own, nodes, &mut ids, config.build)
-            } else {
-                Bvh::build(prims, nodes, &mut ids, config.build)
-            }
-            .map_err(build_error)?;
-            let wide = Bvh4::collapse(&bvh, nodes4).map_err(build_error)?;
-            let figures = BuildFigures {
-                build_ms: millis(start),
-                nodes: wide.nodes().len(),
-                accel_bytes: wide.bytes_used(),
-                depth: wide.depth(),
-            };
-            Ok((figures, visitor.visit(&wide)))
-        }
-        AccelKind::Grid => {
-            // The counting pass is part of the timed build, as a caller sizing memory does it.
-            let options = GridOptions::default();
-            let start = Instant::now();
-            Grid::size_for(prims, options).map_err(build_error)?;
-            let grid = Grid::build(prims, &mut arena.words, &mut arena.refs, options)
-                .map_err(build_error)?;
-            let figures = BuildFigures {
-                build_ms: millis(start),
-                nodes: grid.cells().len().saturating_sub(1),
-                accel_bytes: grid.bytes_used(),
-                depth: 0,
-            };
-            Ok((figures, visitor.visit(&grid)))
-        }
-        AccelKind::Kdtree => {
-            let start = Instant::now();
-            let tree = KdTree::build(
-                prims,
-                &mut arena.kd_nodes,
-                &mut arena.refs,
-                KdOptions::default(),
-            )
-            .map_err(build_error)?;
-            let figures = BuildFigures {
-                build_ms: millis(start),
-                nodes: tree.nodes().len(),
-                accel_bytes: tree.bytes_used(),
-                depth: tree.depth(),
-            };
-            Ok((figures, visitor.visit(&tree)))
-        }
+    // The leaf-order permutation works in place: give it a fresh copy (untimed, like parsing).
+    let leaf_order = config.leaf_order && config.accel.permutes_into_leaf_order();
+    let mut own = if leaf_order {
+        prims.to_vec()
+    } else {
+        Vec::new()
+    };
+    let mut memory = arena.memory();
+    let start = Instant::now();
+    let built = if leaf_order {
+        AnyAccel::build_in_leaf_order(config.accel, &mut own, &mut memory)
+    } else {
+        AnyAccel::build(config.accel, prims, &mut memory)
     }
-}
-
-fn bvh_figures<S: Scalar, P: Primitive<S>>(bvh: &Bvh<'_, S, P>, build_ms: f64) -> BuildFigures {
-    BuildFigures {
+    .map_err(build_error)?;
+    let build_ms = if config.accel.is_brute_force() {
+        0.0
+    } else {
+        millis(start)
+    };
+    let figures = BuildFigures {
         build_ms,
-        nodes: bvh.nodes().len(),
-        accel_bytes: bvh.bytes_used(),
-        depth: bvh.depth(),
-    }
+        nodes: built.node_count(),
+        accel_bytes: built.bytes_used(),
+        depth: built.depth(),
+    };
+    Ok((figures, built.visit(visitor)))
 }
 
 /// Index of the first record that differs bit for bit (or the shorter length), if any.
@@ -468,14 +351,12 @@ pub fn median(xs: &[f64]) -> f64 {
 /// nodes start on a 64-byte boundary, so that each sibling pair (two 32-byte nodes at an even
 /// slot) is one cache line, as the kernel's layout intends.
 pub struct NodeArena<S: Scalar> {
+    /// One spare slot: `Node` is 32-aligned, so skipping at most one reaches a 64-byte line.
     nodes: Vec<Node<S>>,
-    /// Grid cell offsets.
-    words: Vec<u32>,
-    /// Grid or kd-tree references.
-    refs: Vec<u32>,
-    kd_nodes: Vec<KdNode<S>>,
     /// 4-wide BVH nodes (`Node4` is 128-byte aligned, so the vector is too).
     nodes4: Vec<Node4<S>>,
+    kd_nodes: Vec<KdNode<S>>,
+    words: Vec<u32>,
 }
 
 impl<S: Scalar> NodeArena<S> {
@@ -485,56 +366,45 @@ impl<S: Scalar> NodeArena<S> {
     /// counting pass rejects: its build reports the error).
     #[must_use]
     pub fn for_accel<P: Primitive<S>>(accel: AccelKind, prims: &[P]) -> Self {
-        let n = prims.len();
-        let mut arena = Self::with_slots(0);
-        match accel {
-            AccelKind::Bvh => arena = Self::with_slots(nodes_needed(n)),
-            AccelKind::Bvh4 => {
-                arena = Self::with_slots(nodes_needed(n));
-                arena.nodes4 = vec![Node4::EMPTY; nodes4_needed(n)];
-            }
-            AccelKind::Linear => {}
-            AccelKind::Grid => {
-                if let Ok(size) = Grid::size_for(prims, GridOptions::default()) {
-                    arena.words = vec![0; size.cells];
-                    arena.refs = vec![0; size.refs];
-                }
-            }
-            AccelKind::Kdtree => {
-                arena.kd_nodes = vec![KdNode::EMPTY; kdtree::nodes_needed(n)];
-                arena.refs = vec![0; kdtree::refs_needed(n)];
-            }
-        }
-        arena
+        Self::sized(accel.memory_needed(prims).unwrap_or_default())
     }
 
-    /// `slots` BVH nodes (and no grid or kd-tree memory).
+    /// Buffers of the lengths `need` gives.
+    #[must_use]
+    pub fn sized(need: raykernel::MemoryNeeded) -> Self {
+        Self {
+            nodes: vec![Node::EMPTY; need.nodes + 1],
+            nodes4: vec![Node4::EMPTY; need.nodes4],
+            kd_nodes: vec![KdNode::EMPTY; need.kd_nodes],
+            words: vec![0; need.words],
+        }
+    }
+
+    /// `slots` BVH nodes and nothing else.
     #[must_use]
     pub fn with_slots(slots: usize) -> Self {
-        // One spare slot: `Node` is 32-aligned, so skipping at most one reaches a 64-byte line.
-        Self {
-            nodes: vec![Node::EMPTY; slots + 1],
-            words: Vec::new(),
-            refs: Vec::new(),
-            kd_nodes: Vec::new(),
-            nodes4: Vec::new(),
-        }
+        Self::sized(raykernel::MemoryNeeded {
+            nodes: slots,
+            ..raykernel::MemoryNeeded::NONE
+        })
     }
 
-    /// The `slots` requested, starting on a 64-byte boundary.
+    /// The BVH nodes alone, starting on a 64-byte boundary.
     pub fn slots(&mut self) -> &mut [Node<S>] {
-        let misaligned = (self.nodes.as_ptr() as usize) % Self::LINE != 0;
-        let skip = usize::from(misaligned);
-        let len = self.nodes.len() - 1;
-        &mut self.nodes[skip..skip + len]
+        self.memory().nodes
     }
 
-    /// The BVH slots (as [`NodeArena::slots`]) and the 4-wide nodes, for [`AccelKind::Bvh4`].
-    pub fn bvh4_slots(&mut self) -> (&mut [Node<S>], &mut [Node4<S>]) {
+    /// The buffers as the kernel's caller memory, BVH nodes starting on a 64-byte boundary.
+    pub fn memory(&mut self) -> AccelMemory<'_, S> {
         let misaligned = (self.nodes.as_ptr() as usize) % Self::LINE != 0;
         let skip = usize::from(misaligned);
         let len = self.nodes.len() - 1;
-        (&mut self.nodes[skip..skip + len], &mut self.nodes4)
+        AccelMemory {
+            nodes: &mut self.nodes[skip..skip + len],
+            nodes4: &mut self.nodes4,
+            kd_nodes: &mut self.kd_nodes,
+            words: &mut self.words,
+        }
     }
 }
 

@@ -10,8 +10,9 @@ use host::bake::{run_bake, run_trace_baked, BakeAccel, BakeArgs, TraceBakedArgs}
 use host::cli::{run_trace, TraceArgs};
 use host::mesh::unit_icosphere;
 use host::rayfile::write_rays;
-use host::trace::{AccelKind, Builder, Mode};
+use host::trace::{Builder, Mode};
 use raykernel::bvh::DEFAULT_LEAF_SIZE;
+use raykernel::AccelKind;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -35,8 +36,8 @@ fn generated_obj(dir: &Path) -> PathBuf {
 fn check_scene(obj: &Path, rays: &Path, dir: &Path) {
     for mode in [Mode::F32, Mode::Fixed] {
         for (accel, kind) in [
-            (BakeAccel::Bvh, AccelKind::Bvh),
-            (BakeAccel::Bvh4, AccelKind::Bvh4),
+            (BakeAccel::Bvh, AccelKind::Bvh(Default::default())),
+            (BakeAccel::Bvh4, AccelKind::Bvh4(Default::default())),
         ] {
             let case = format!("{} {mode:?} {accel:?}", obj.display());
             let baked = dir.join("mesh.baked");

@@ -7,7 +7,8 @@ use host::cli::{run_check, CheckArgs, SettingsArgs};
 use host::render::render_reference;
 use host::spec::SceneSpec;
 use host::trace::Mode;
-use raykernel::render::{scenes, AccelChoice};
+use raykernel::render::scenes;
+use raykernel::AccelKind;
 use std::process::Command;
 
 #[test]
@@ -55,7 +56,7 @@ fn check_command_exits_zero_and_prints_a_json_summary() {
 #[test]
 fn a_one_bit_difference_is_reported_at_its_pixel_with_both_values() {
     let d = scenes::CORNELL;
-    let reference = render_reference(&d, d.settings, Mode::F32, AccelChoice::default()).unwrap();
+    let reference = render_reference(&d, d.settings, Mode::F32, AccelKind::default()).unwrap();
     let mut other = reference.clone();
     // Pixel (5, 9): its blue byte's lowest bit.
     let i = 3 * (9 * d.settings.width as usize + 5) + 2;

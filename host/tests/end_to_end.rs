@@ -6,8 +6,12 @@ mod common;
 use common::{icosphere, random_rays, temp_dir, Rng};
 use host::cli::{run_trace, TraceArgs, TraceReport};
 use host::rayfile::{read_hits, write_rays};
-use host::trace::{AccelKind, Builder, Mode};
+use host::trace::{Builder, Mode};
 use host::{HitRecord, RayRecord};
+use raykernel::bvh::BuildOptions;
+use raykernel::grid::GridOptions;
+use raykernel::kdtree::KdOptions;
+use raykernel::AccelKind;
 use std::path::{Path, PathBuf};
 
 const CENTER: [f64; 3] = [0.3, -0.2, 0.1];
@@ -87,7 +91,7 @@ fn scene(name: &str) -> Scene {
 fn args(s: &Scene, accel: AccelKind, builder: Builder, mode: Mode, leaf: u32) -> TraceArgs {
     let out = s
         .dir
-        .join(format!("{accel:?}.{builder:?}.{mode:?}.{leaf}.hits"));
+        .join(format!("{}.{builder:?}.{mode:?}.{leaf}.hits", accel.name()));
     TraceArgs {
         scene: s.obj.clone(),
         rays: s.rays.clone(),
@@ -138,7 +142,13 @@ fn every_bvh_configuration_matches_brute_force_byte_for_byte() {
 
         for builder in [Builder::Sah, Builder::Median, Builder::Midpoint] {
             for leaf in [1, 4] {
-                let a = args(&s, AccelKind::Bvh, builder, mode, leaf);
+                let a = args(
+                    &s,
+                    AccelKind::Bvh(BuildOptions::DEFAULT),
+                    builder,
+                    mode,
+                    leaf,
+                );
                 let (report, bytes) = run(&a);
                 if bytes != reference {
                     let got = hits(&a.out);
@@ -166,7 +176,10 @@ fn grid_and_kdtree_match_brute_force_byte_for_byte() {
     let s = scene("end_to_end_grid_kdtree");
     for mode in [Mode::F32, Mode::Fixed] {
         let (_, reference) = run(&args(&s, AccelKind::Linear, Builder::Sah, mode, 4));
-        for accel in [AccelKind::Grid, AccelKind::Kdtree] {
+        for accel in [
+            AccelKind::Grid(GridOptions::DEFAULT),
+            AccelKind::KdTree(KdOptions::DEFAULT),
+        ] {
             let a = args(&s, accel, Builder::Sah, mode, 4);
             let (report, bytes) = run(&a);
             assert!(
@@ -183,7 +196,13 @@ fn grid_and_kdtree_match_brute_force_byte_for_byte() {
 fn modes_agree_on_which_rays_hit_the_sphere() {
     let s = scene("end_to_end_modes");
     let trace = |mode| {
-        let a = args(&s, AccelKind::Bvh, Builder::Sah, mode, 4);
+        let a = args(
+            &s,
+            AccelKind::Bvh(BuildOptions::DEFAULT),
+            Builder::Sah,
+            mode,
+            4,
+        );
         run(&a);
         hits(&a.out)
     };
@@ -197,7 +216,7 @@ fn modes_agree_on_which_rays_hit_the_sphere() {
 #[test]
 fn stride_traces_every_kth_ray_and_matches_the_full_run() {
     let s = scene("end_to_end_stride");
-    for accel in [AccelKind::Bvh, AccelKind::Linear] {
+    for accel in [AccelKind::Bvh(BuildOptions::DEFAULT), AccelKind::Linear] {
         let full = args(&s, accel, Builder::Median, Mode::F32, 4);
         run(&full);
         let all = hits(&full.out);
@@ -220,7 +239,13 @@ fn leaf_order_writes_the_same_hit_files() {
     for mode in [Mode::F32, Mode::Fixed] {
         for builder in [Builder::Sah, Builder::Median, Builder::Midpoint] {
             for leaf in [1, 4, 16] {
-                let normal = args(&s, AccelKind::Bvh, builder, mode, leaf);
+                let normal = args(
+                    &s,
+                    AccelKind::Bvh(BuildOptions::DEFAULT),
+                    builder,
+                    mode,
+                    leaf,
+                );
                 let (normal_report, normal_bytes) = run(&normal);
                 let mut a = normal.clone();
                 a.leaf_order = true;
@@ -253,7 +278,13 @@ fn bvh4_matches_brute_force_byte_for_byte() {
         for builder in [Builder::Sah, Builder::Median, Builder::Midpoint] {
             for leaf in [1, 4, 16] {
                 for leaf_order in [false, true] {
-                    let mut a = args(&s, AccelKind::Bvh4, builder, mode, leaf);
+                    let mut a = args(
+                        &s,
+                        AccelKind::Bvh4(BuildOptions::DEFAULT),
+                        builder,
+                        mode,
+                        leaf,
+                    );
                     a.leaf_order = leaf_order;
                     a.out = s.dir.join(format!(
                         "bvh4.{builder:?}.{mode:?}.{leaf}.{leaf_order}.hits"
@@ -277,7 +308,13 @@ fn bvh4_matches_brute_force_byte_for_byte() {
 fn several_runs_report_medians_and_write_the_same_hits() {
     let s = scene("end_to_end_runs");
     for leaf_order in [false, true] {
-        let mut one = args(&s, AccelKind::Bvh, Builder::Sah, Mode::Fixed, 4);
+        let mut one = args(
+            &s,
+            AccelKind::Bvh(BuildOptions::DEFAULT),
+            Builder::Sah,
+            Mode::Fixed,
+            4,
+        );
         one.leaf_order = leaf_order;
         let (_, once) = run(&one);
         let mut three = one.clone();

@@ -7,8 +7,10 @@ mod common;
 use common::{icosphere, temp_dir};
 use host::cli::{run_render, CameraArgs, RenderArgs, SettingsArgs};
 use host::render::{decode_png, render, RenderOptions};
-use host::trace::{AccelKind, Builder, Mode};
+use host::trace::{Builder, Mode};
+use raykernel::bvh::BuildOptions;
 use raykernel::render::scenes;
+use raykernel::AccelKind;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -47,7 +49,7 @@ fn small(scene: Option<PathBuf>, out: PathBuf, mode: Mode) -> RenderArgs {
         camera: CameraArgs::default(),
         mode,
         threads: Some(2),
-        accel: AccelKind::Bvh,
+        accel: AccelKind::Bvh(BuildOptions::DEFAULT),
         builder: Builder::Sah,
         no_reinsertion: false,
         leaf: 4,

@@ -7,8 +7,11 @@ mod common;
 use common::{bbox, random_rays, Camera, Rng};
 use host::obj::load_obj;
 use host::rayfile::encode_hits;
-use host::trace::{trace, AccelKind, Mode, TraceConfig};
+use host::trace::{trace, Mode, TraceConfig};
 use raykernel::bvh::{BuildOptions, BuilderKind};
+use raykernel::grid::GridOptions;
+use raykernel::kdtree::KdOptions;
+use raykernel::AccelKind;
 use std::path::PathBuf;
 
 fn shared() -> Option<PathBuf> {
@@ -36,13 +39,12 @@ fn bunny_bvh_matches_brute_force_for_every_builder_and_mode() {
     rays.extend(random_rays(&mut Rng::new(0xB0_0B), lo, hi, 1024));
 
     for mode in [Mode::F32, Mode::Fixed] {
-        let config = |accel, builder| TraceConfig {
-            accel,
-            build: BuildOptions {
+        let config = |accel: AccelKind, builder| TraceConfig {
+            accel: accel.with_build_options(BuildOptions {
                 builder,
                 max_leaf_size: 4,
                 reinsertion: true,
-            },
+            }),
             mode,
             stride: 1,
             runs: 1,
@@ -59,7 +61,13 @@ fn bunny_bvh_matches_brute_force_for_every_builder_and_mode() {
         assert!(hits > 600 && hits < 1900, "{mode:?}: {hits} hits");
         let reference = encode_hits(&linear.hits);
         for builder in BuilderKind::ALL {
-            let bvh = trace(&mesh, &obj, &rays, &config(AccelKind::Bvh, builder)).unwrap();
+            let bvh = trace(
+                &mesh,
+                &obj,
+                &rays,
+                &config(AccelKind::Bvh(BuildOptions::DEFAULT), builder),
+            )
+            .unwrap();
             let differ: Vec<_> = (0..rays.len())
                 .filter(|&i| bvh.hits[i] != linear.hits[i])
                 .take(5)
@@ -70,7 +78,10 @@ fn bunny_bvh_matches_brute_force_for_every_builder_and_mode() {
                 "{mode:?} {builder:?}: differs from linear, first (ray, bvh, linear): {differ:?}"
             );
         }
-        for accel in [AccelKind::Grid, AccelKind::Kdtree] {
+        for accel in [
+            AccelKind::Grid(GridOptions::DEFAULT),
+            AccelKind::KdTree(KdOptions::DEFAULT),
+        ] {
             let other = trace(&mesh, &obj, &rays, &config(accel, BuilderKind::Sah)).unwrap();
             assert!(
                 encode_hits(&other.hits) == reference,

@@ -49,7 +49,11 @@ pub use accel::bvh::{Bvh, Node};
 pub use accel::bvh4::{Bvh4, Node4};
 pub use accel::grid::Grid;
 pub use accel::kdtree::{KdNode, KdTree};
-pub use accel::{Accel, Arena, BuildError, Counters, Linear, Nearest, NoStats, TraversalStats};
+pub use accel::{
+    Accel, AccelFamily, AccelKind, AccelMemory, AccelVisitor, AnyAccel, AnyFamily, Arena,
+    BuildError, Bvh4Family, BvhFamily, Counters, GridFamily, KdTreeFamily, Linear, LinearFamily,
+    MemoryNeeded, Nearest, NoStats, TraversalStats, TrianglesOnly, UnknownAccel, MAX_PRIMS,
+};
 pub use geom::{spawn, Aabb, Hit, Primitive, Ray, Sphere, Triangle};
 pub use glam;
 pub use scalar::{PointError, RayError, Scalar, Vec3x, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16};

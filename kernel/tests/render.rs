@@ -9,19 +9,22 @@ use raykernel::render::sampling::{
 };
 use raykernel::render::scenes::{self, SceneData};
 use raykernel::render::{
-    memory_needed, AccelChoice, AccelMemory, Camera, Filter, Item, Light, Material, MemoryNeeded,
-    Object, ObjectSlot, Problem, Renderer, SamplerKind, Scene, SceneError, Settings, Shape, Tile,
-    MAX_LIGHTS,
+    memory_needed, Camera, Filter, Item, Light, Material, Object, ObjectSlot, Problem,
+    RenderMemory, RenderMemoryNeeded, Renderer, SamplerKind, Scene, SceneError, Settings, Shape,
+    Tile, MAX_LIGHTS,
 };
 use raykernel::spawn::SpawnScalar;
-use raykernel::{grid::GridOptions, kdtree::KdOptions, KdNode, Node, Sphere, Triangle, I16F16};
+use raykernel::{
+    grid::GridOptions, kdtree::KdOptions, AccelKind, AccelMemory, AnyFamily, KdNode, MemoryNeeded,
+    Node, Node4, Sphere, Triangle, I16F16,
+};
 use std::f64::consts::PI;
 
 /// Renders `scene` into linear RGB with a BVH (or brute force).
 fn render<S: SpawnScalar>(
     scene: &Scene<'_, S>,
     settings: Settings,
-    accel: AccelChoice,
+    accel: AccelKind,
 ) -> Result<Vec<[f32; 3]>, SceneError> {
     let mut memory = Memory::new(scene, accel);
     let r = Renderer::new(scene, settings, accel, memory.lend())?;
@@ -65,29 +68,34 @@ fn cube(half: f32, x_offset: f32) -> Vec<[[f32; 3]; 3]> {
 /// Accelerator buffers of the sizes [`memory_needed`] gives.
 struct Memory<'m, S: SpawnScalar> {
     objects: Vec<ObjectSlot<'m, S>>,
-    bvh_nodes: Vec<Node<S>>,
+    nodes: Vec<Node<S>>,
+    nodes4: Vec<Node4<S>>,
     kd_nodes: Vec<KdNode<S>>,
     words: Vec<u32>,
 }
 
 impl<'m, S: SpawnScalar> Memory<'m, S> {
-    fn new(scene: &Scene<'_, S>, accel: AccelChoice) -> Self {
-        Self::sized(memory_needed(scene.objects, accel))
+    fn new(scene: &Scene<'_, S>, accel: AccelKind) -> Self {
+        Self::sized(memory_needed::<S, AnyFamily>(scene.objects, &accel))
     }
-    fn sized(n: MemoryNeeded) -> Self {
+    fn sized(n: RenderMemoryNeeded) -> Self {
         Self {
             objects: vec![ObjectSlot::EMPTY; n.objects],
-            bvh_nodes: vec![Node::EMPTY; n.bvh_nodes],
-            kd_nodes: vec![KdNode::EMPTY; n.kd_nodes],
-            words: vec![0; n.words],
+            nodes: vec![Node::EMPTY; n.accel.nodes],
+            nodes4: vec![Node4::EMPTY; n.accel.nodes4],
+            kd_nodes: vec![KdNode::EMPTY; n.accel.kd_nodes],
+            words: vec![0; n.accel.words],
         }
     }
-    fn lend(&'m mut self) -> AccelMemory<'m, S> {
-        AccelMemory {
+    fn lend(&'m mut self) -> RenderMemory<'m, S> {
+        RenderMemory {
             objects: &mut self.objects,
-            bvh_nodes: &mut self.bvh_nodes,
-            kd_nodes: &mut self.kd_nodes,
-            words: &mut self.words,
+            accel: AccelMemory {
+                nodes: &mut self.nodes,
+                nodes4: &mut self.nodes4,
+                kd_nodes: &mut self.kd_nodes,
+                words: &mut self.words,
+            },
         }
     }
 }
@@ -158,7 +166,7 @@ fn point_light_case<S: SpawnScalar>() {
     let px = render(
         &scene,
         one_pixel(1, SamplerKind::Stratified),
-        AccelChoice::default(),
+        AccelKind::default(),
     )
     .unwrap();
     let want = f64::from(rho) / PI * f64::from(intensity) / f64::from(h * h);
@@ -190,7 +198,7 @@ fn sphere_light_case<S: SpawnScalar>(sampler: SamplerKind) {
         camera: narrow_camera([3.0, 1.0, 0.0]),
         background: [0.0; 3],
     };
-    let px = render(&scene, one_pixel(1024, sampler), AccelChoice::default()).unwrap();
+    let px = render(&scene, one_pixel(1024, sampler), AccelKind::default()).unwrap();
     let want = f64::from(rho * radiance) * f64::from(r / d).powi(2);
     for c in px[0] {
         assert!(
@@ -239,7 +247,7 @@ fn rect_light_case<S: SpawnScalar>() {
     let px = render(
         &scene,
         one_pixel(4096, SamplerKind::Sobol),
-        AccelChoice::default(),
+        AccelKind::default(),
     )
     .unwrap();
     let e = 4.0 * corner_irradiance(f64::from(half), f64::from(half), f64::from(h));
@@ -304,7 +312,7 @@ fn furnace_case<S: SpawnScalar>() {
             max_depth: 3,
             ..Settings::default()
         };
-        let px = render(&scene, settings, AccelChoice::default()).unwrap();
+        let px = render(&scene, settings, AccelKind::default()).unwrap();
         let centre = px[4 * 9 + 4];
         let want = rho * l;
         for c in centre {
@@ -326,7 +334,7 @@ fn furnace_case<S: SpawnScalar>() {
                 max_depth: 0,
                 ..settings
             },
-            AccelChoice::default(),
+            AccelKind::default(),
         );
         assert_eq!(
             none.unwrap()[4 * 9 + 4],
@@ -492,9 +500,9 @@ fn with_scene<S: SpawnScalar, R>(d: &SceneData<'_>, f: impl FnOnce(&Scene<'_, S>
 fn tiles_equal_whole<S: SpawnScalar>(d: &SceneData<'_>) {
     with_scene::<S, _>(d, |scene| {
         let st = d.settings;
-        let whole = render(scene, st, AccelChoice::default()).unwrap();
-        let mut memory = Memory::new(scene, AccelChoice::default());
-        let r = Renderer::new(scene, st, AccelChoice::default(), memory.lend()).unwrap();
+        let whole = render(scene, st, AccelKind::default()).unwrap();
+        let mut memory = Memory::new(scene, AccelKind::default());
+        let r = Renderer::new(scene, st, AccelKind::default(), memory.lend()).unwrap();
         // Odd tiles, rendered bottom-right first.
         let mut tiled = vec![[0.0f32; 3]; whole.len()];
         let (tw, th) = (7u32, 5u32);
@@ -521,9 +529,10 @@ fn tiles_equal_whole<S: SpawnScalar>(d: &SceneData<'_>) {
         assert_eq!(bits(&whole), bits(&tiled), "{} {}", d.name, S::NAME);
         // Brute force, the grid and the kd-tree give the same bits.
         for accel in [
-            AccelChoice::Linear,
-            AccelChoice::Grid(GridOptions::default()),
-            AccelChoice::KdTree(KdOptions::default()),
+            AccelKind::Linear,
+            AccelKind::Bvh4(BuildOptions::default()),
+            AccelKind::Grid(GridOptions::default()),
+            AccelKind::KdTree(KdOptions::default()),
         ] {
             let other = render(scene, st, accel).unwrap();
             assert_eq!(
@@ -549,8 +558,8 @@ fn tiles_in_any_order_equal_the_whole_image() {
 fn plans_follow_the_scenes() {
     let plan = |d: &SceneData<'_>| {
         with_scene::<f32, _>(d, |scene| {
-            let mut memory = Memory::new(scene, AccelChoice::default());
-            let plan = *Renderer::new(scene, d.settings, AccelChoice::default(), memory.lend())
+            let mut memory = Memory::new(scene, AccelKind::default());
+            let plan = *Renderer::new(scene, d.settings, AccelKind::default(), memory.lend())
                 .unwrap()
                 .plan();
             plan
@@ -635,10 +644,10 @@ fn camera_rays_only_case<S: SpawnScalar>(d: &SceneData<'_>) {
             ..*d
         };
         with_scene::<S, _>(&data, |scene| {
-            let mut memory = Memory::new(scene, AccelChoice::default());
-            let r = Renderer::new(scene, settings, AccelChoice::default(), memory.lend()).unwrap();
+            let mut memory = Memory::new(scene, AccelKind::default());
+            let r = Renderer::new(scene, settings, AccelKind::default(), memory.lend()).unwrap();
             assert_eq!(r.plan().camera_rays_only(), lights.is_empty(), "{}", d.name);
-            let image = render(scene, settings, AccelChoice::default()).unwrap();
+            let image = render(scene, settings, AccelKind::default()).unwrap();
             images.push(
                 image
                     .iter()
@@ -676,7 +685,7 @@ fn check_error(
         camera,
         background: [0.0; 3],
     };
-    render(&scene, settings, AccelChoice::default()).unwrap_err()
+    render(&scene, settings, AccelKind::default()).unwrap_err()
 }
 
 #[test]
@@ -885,42 +894,67 @@ fn buffers_and_tiles_are_checked_exactly() {
         spp: 1,
         ..Settings::default()
     };
-    let bvh = AccelChoice::Bvh(BuildOptions {
+    let options = BuildOptions {
         builder: BuilderKind::Median,
         max_leaf_size: 1,
         reinsertion: true,
-    });
-    let kd = AccelChoice::KdTree(KdOptions::default());
-    let grid = AccelChoice::Grid(GridOptions::default());
-    let bvh_need = memory_needed(scene.objects, bvh);
-    let kd_need = memory_needed(scene.objects, kd);
-    let grid_need = memory_needed(scene.objects, grid);
-    let need = |bvh_nodes, kd_nodes, words| MemoryNeeded {
-        objects: 2,
-        bvh_nodes,
-        kd_nodes,
-        words,
     };
-    // Two objects of two triangles: BVH 2·(2n) nodes and n ids, kd-tree 4n+1 nodes and 6n refs.
-    assert_eq!(bvh_need, need(8, 0, 4));
-    assert_eq!(kd_need, need(0, 18, 24));
-    assert_eq!((grid_need.bvh_nodes, grid_need.kd_nodes), (0, 0));
-    assert!(grid_need.words > 0);
+    let bvh = AccelKind::Bvh(options);
+    let bvh4 = AccelKind::Bvh4(options);
+    let kd = AccelKind::KdTree(KdOptions::default());
+    let grid = AccelKind::Grid(GridOptions::default());
+    let needed = |accel| memory_needed::<f32, AnyFamily>(scene.objects, &accel);
+    let (bvh_need, bvh4_need, kd_need, grid_need) =
+        (needed(bvh), needed(bvh4), needed(kd), needed(grid));
+    let need = |nodes, nodes4, kd_nodes, words| RenderMemoryNeeded {
+        objects: 2,
+        accel: MemoryNeeded {
+            nodes,
+            nodes4,
+            kd_nodes,
+            words,
+        },
+    };
+    // Two objects of two triangles: BVH 2·(2n) nodes and n ids, the 4-wide BVH one wide node
+    // each besides, kd-tree 4n+1 nodes and 6n refs; and for every structure the top-level BVH
+    // over the two objects, 4 nodes and 2 ids.
+    assert_eq!(bvh_need, need(8 + 4, 0, 0, 4 + 2));
+    assert_eq!(bvh4_need, need(8 + 4, 2, 0, 4 + 2));
+    assert_eq!(kd_need, need(4, 0, 18, 24 + 2));
+    let g = grid_need.accel;
+    assert_eq!((g.nodes, g.nodes4, g.kd_nodes), (4, 0, 0));
+    assert!(g.words > 0);
     // One element short in each buffer: a typed error naming it, with the exact sizes.
-    for (accel, n) in [(bvh, bvh_need), (kd, kd_need), (grid, grid_need)] {
+    let cases = [
+        (bvh, bvh_need),
+        (bvh4, bvh4_need),
+        (kd, kd_need),
+        (grid, grid_need),
+    ];
+    for (accel, n) in cases {
+        let a = n.accel;
         let shorts = [
-            ("objects", 2, MemoryNeeded { objects: 1, ..n }),
+            ("objects", 2, RenderMemoryNeeded { objects: 1, ..n }),
             (
-                "bvh_nodes",
-                n.bvh_nodes,
-                need(n.bvh_nodes.wrapping_sub(1), n.kd_nodes, n.words),
+                "nodes",
+                a.nodes,
+                need(a.nodes.wrapping_sub(1), a.nodes4, a.kd_nodes, a.words),
+            ),
+            (
+                "nodes4",
+                a.nodes4,
+                need(a.nodes, a.nodes4.wrapping_sub(1), a.kd_nodes, a.words),
             ),
             (
                 "kd_nodes",
-                n.kd_nodes,
-                need(n.bvh_nodes, n.kd_nodes.wrapping_sub(1), n.words),
+                a.kd_nodes,
+                need(a.nodes, a.nodes4, a.kd_nodes.wrapping_sub(1), a.words),
             ),
-            ("words", n.words, need(n.bvh_nodes, n.kd_nodes, n.words - 1)),
+            (
+                "words",
+                a.words,
+                need(a.nodes, a.nodes4, a.kd_nodes, a.words - 1),
+            ),
         ];
         for (field, needed, short) in shorts {
             if needed == 0 {
@@ -938,13 +972,18 @@ fn buffers_and_tiles_are_checked_exactly() {
         let mut memory = Memory::sized(n);
         assert!(Renderer::new(&scene, st, accel, memory.lend()).is_ok());
     }
-    // Brute force needs no memory at all.
-    let mut slots = [ObjectSlot::EMPTY; 2];
-    let memory = AccelMemory {
+    // Brute force needs only the top-level BVH's memory.
+    let (mut nodes, mut ids) = ([Node::EMPTY; 4], [0u32; 2]);
+    let mut slots = [ObjectSlot::<f32>::EMPTY; 2];
+    let memory = RenderMemory {
         objects: &mut slots,
-        ..AccelMemory::default()
+        accel: AccelMemory {
+            nodes: &mut nodes,
+            words: &mut ids,
+            ..AccelMemory::default()
+        },
     };
-    let r = Renderer::new(&scene, st, AccelChoice::Linear, memory).unwrap();
+    let r = Renderer::new(&scene, st, AccelKind::Linear, memory).unwrap();
     let mut out = vec![0u8; 4 * 3 * 3];
     r.render_srgb8(&mut out).unwrap();
     let err = r.render_srgb8(&mut out[..35]).unwrap_err();
@@ -1023,7 +1062,7 @@ fn no_sphere_acne<S: SpawnScalar>(scale: f32, offset: f32) {
         max_depth: 1,
         ..Settings::default()
     };
-    let px = render(&scene, st, AccelChoice::default()).unwrap();
+    let px = render(&scene, st, AccelKind::default()).unwrap();
     let bad = px
         .iter()
         .filter(|p| **p != [1.0; 3] && **p != [0.5; 3])

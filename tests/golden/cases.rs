@@ -10,9 +10,12 @@
 
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::render::scenes::{self, SceneData};
-use raykernel::render::{AccelChoice, AccelMemory, Object, ObjectSlot, Renderer, Shape, Tile};
+use raykernel::render::{Object, ObjectSlot, RenderMemory, Renderer, Shape, Tile};
 use raykernel::spawn::SpawnScalar;
-use raykernel::{Accel, Bvh, Hit, Linear, Node, Primitive, Ray, Scalar, Sphere, Triangle, I16F16};
+use raykernel::{
+    Accel, AccelMemory, Bvh, BvhFamily, Hit, Linear, Node, Primitive, Ray, Scalar, Sphere,
+    Triangle, I16F16,
+};
 
 /// Triangles of the level-1 icosphere.
 pub const ICO_TRIS: usize = 80;
@@ -413,18 +416,22 @@ pub fn render_hash<S: Bits + SpawnScalar>(data: &SceneData<'_>) -> Result<u64, F
     data.spheres_into(spheres).map_err(reject)?;
     let mut objects = [Object::new(Shape::Triangles(&[]), 0); RENDER_OBJECTS];
     let scene = data.scene(tris, spheres, &mut objects).map_err(reject)?;
+    // Every object's BVH, then the top-level BVH over the objects.
     let mut nodes = [Node::<S>::EMPTY;
-        nodes_needed(RENDER_TRIS) + nodes_needed(RENDER_SPHERES) + 2 * RENDER_OBJECTS];
-    let mut ids = [0u32; RENDER_TRIS + RENDER_SPHERES];
-    let accel = AccelChoice::default();
-    let mut slots = [ObjectSlot::EMPTY; RENDER_OBJECTS];
-    let memory = AccelMemory {
+        nodes_needed(RENDER_TRIS) + nodes_needed(RENDER_SPHERES) + 4 * RENDER_OBJECTS];
+    let mut ids = [0u32; RENDER_TRIS + RENDER_SPHERES + RENDER_OBJECTS];
+    // The BVH family alone: the other structures are not linked into the on-target tests.
+    let mut slots = [ObjectSlot::<S, BvhFamily>::EMPTY; RENDER_OBJECTS];
+    let memory = RenderMemory {
         objects: &mut slots,
-        bvh_nodes: &mut nodes,
-        kd_nodes: &mut [],
-        words: &mut ids,
+        accel: AccelMemory {
+            nodes: &mut nodes,
+            words: &mut ids,
+            ..AccelMemory::default()
+        },
     };
-    let r = Renderer::new(&scene, data.settings, accel, memory).map_err(reject)?;
+    let r =
+        Renderer::new(&scene, data.settings, BuildOptions::default(), memory).map_err(reject)?;
     let width = data.settings.width as usize;
     let mut row = [0u8; 3 * RENDER_WIDTH];
     let row = row

@@ -30,7 +30,7 @@ pub enum BuildError {
         /// Slots provided.
         available: usize,
     },
-    /// More primitives than a 32-bit id can address (`u32::MAX` is reserved for "miss").
+    /// More than [`crate::MAX_PRIMS`] primitives.
     TooManyPrims {
         /// The number of primitives given.
         count: usize,
@@ -83,7 +83,11 @@ impl fmt::Display for BuildError {
                 )
             }
             Self::TooManyPrims { count } => {
-                write!(f, "{count} primitives exceed the 32-bit id space")
+                write!(
+                    f,
+                    "{count} primitives exceed the limit of {}",
+                    crate::MAX_PRIMS
+                )
             }
             Self::BadPrimitive {
                 prim,

@@ -4,16 +4,31 @@
 //! ([`bvh`], and its 4-wide form [`bvh4`]), a uniform spatial subdivision ([`grid`]) and an axis-aligned binary space
 //! partition ([`kdtree`]); and brute force ([`Linear`]), the reference.
 
+mod any;
 pub(crate) mod baked;
 pub(crate) mod bvh;
 pub(crate) mod bvh4;
 mod error;
+mod family;
 pub(crate) mod grid;
+mod input;
 pub(crate) mod kdtree;
+mod kind;
 mod linear;
+mod memory;
 
+pub use any::{AccelVisitor, AnyAccel};
 pub use error::{Arena, BuildError};
+pub use family::{
+    AccelFamily, AnyFamily, Bvh4Family, BvhFamily, GridFamily, KdTreeFamily, LinearFamily,
+    TrianglesOnly,
+};
+pub use input::MAX_PRIMS;
+pub(crate) use input::{check_count, check_each};
+pub use kind::{AccelKind, UnknownAccel};
 pub use linear::Linear;
+pub(crate) use memory::take;
+pub use memory::{AccelMemory, MemoryNeeded};
 
 use crate::geom::{Hit, Primitive, Ray};
 use crate::scalar::Scalar;

@@ -2,11 +2,12 @@ use super::{Aabb, Ray};
 use crate::scalar::PointError;
 use crate::scalar::Scalar;
 
-/// Something an accelerator can hold: it has bounds and a pure intersection test.
+/// Something an accelerator can hold: it has bounds and a pure intersection test. Plain data
+/// (`Copy`), so built structures over it are `Copy` too.
 ///
 /// `hit_t` must be a pure function of the ray and the primitive, so that every accelerator
 /// computes the same bits for it.
-pub trait Primitive<S: Scalar> {
+pub trait Primitive<S: Scalar>: Copy + core::fmt::Debug {
     /// A box holding the primitive.
     fn bounds(&self) -> Aabb<S>;
     /// Checks the primitive's data. On error, the index of the bad vertex (or field).

@@ -2,10 +2,12 @@
 //! reflection rays at mirror and glossy ones. Iterative; each step does only what the render
 //! plan says the scene needs.
 
-use super::geometry::{dir_in_mode, Surface, SurfacePoint};
+use super::geometry::Surface;
 use super::sampling::{phong_lobe, tent, to_world, uniform_cone, SampleStream};
 use super::scene::{Filter, Light, Material};
+use super::surface::{dir_in_mode, SurfacePoint};
 use super::{RenderPlan, RenderStats, Renderer};
+use crate::accel::AccelFamily;
 use crate::accel::NoStats;
 use crate::geom::spawn::{shadow_t_max, SpawnScalar};
 use crate::geom::Ray;
@@ -20,8 +22,8 @@ use glam::Vec3;
 /// tenth. Bare-metal targets keep the optimiser's choice, for flash (see `ray_data` in
 /// `scalar/float.rs`).
 #[cfg_attr(not(target_os = "none"), inline(always))]
-pub(crate) fn sample_radiance<S: SpawnScalar>(
-    r: &Renderer<'_, S>,
+pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
+    r: &Renderer<'_, S, F>,
     x: u32,
     y: u32,
     stream: &mut SampleStream,
@@ -131,8 +133,8 @@ pub(crate) fn sample_radiance<S: SpawnScalar>(
 /// other surfaces are black. The same bits as [`sample_radiance`] under that plan (the same
 /// operations in the same order), without its sample stream, path state and bounce loop.
 #[cfg_attr(not(target_os = "none"), inline(always))]
-pub(crate) fn camera_ray_radiance<S: SpawnScalar>(
-    r: &Renderer<'_, S>,
+pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>>(
+    r: &Renderer<'_, S, F>,
     x: u32,
     y: u32,
     stats: &mut RenderStats,
@@ -161,7 +163,10 @@ pub(crate) fn camera_ray_radiance<S: SpawnScalar>(
 
 /// Object `object`'s material (`None` only for an index the renderer's checks rule out).
 #[inline]
-fn material_of<'r, S: SpawnScalar>(r: &'r Renderer<'_, S>, object: usize) -> Option<&'r Material> {
+fn material_of<'r, S: SpawnScalar, F: AccelFamily<S>>(
+    r: &'r Renderer<'_, S, F>,
+    object: usize,
+) -> Option<&'r Material> {
     r.geometry
         .object(object)
         .and_then(|o| r.materials.get(o.material as usize))
@@ -183,9 +188,13 @@ fn reflect(d: Vec3, n: Vec3) -> Vec3 {
 }
 
 /// Radiance a camera or reflection ray sees on light `i`'s surface.
-fn light_seen<S: SpawnScalar>(r: &Renderer<'_, S>, i: usize, dir: Vec3) -> Vec3 {
+fn light_seen<S: SpawnScalar, F: AccelFamily<S>>(
+    r: &Renderer<'_, S, F>,
+    i: usize,
+    dir: Vec3,
+) -> Vec3 {
     match (r.lights.get(i), r.geometry.lights.get(i)) {
-        (Some(Light::Rect { radiance, .. }), Some(super::geometry::LightGeom::Rect(_, n))) => {
+        (Some(Light::Rect { radiance, .. }), Some(super::lights::LightGeom::Rect(_, n))) => {
             if dir.dot(Vec3::from_array(*n)) < 0.0 {
                 Vec3::from_array(*radiance)
             } else {
@@ -199,8 +208,8 @@ fn light_seen<S: SpawnScalar>(r: &Renderer<'_, S>, i: usize, dir: Vec3) -> Vec3 
 
 /// Irradiance-like sum `Σ L·cos θ / pdf` over every light at a diffuse point (the caller
 /// multiplies by `albedo / π`), one sample per area light, each tested by a shadow ray.
-fn direct_light<S: SpawnScalar>(
-    r: &Renderer<'_, S>,
+fn direct_light<S: SpawnScalar, F: AccelFamily<S>>(
+    r: &Renderer<'_, S, F>,
     sp: &SurfacePoint<'_, S>,
     nf: Vec3,
     time: f32,
@@ -292,8 +301,8 @@ fn direct_light<S: SpawnScalar>(
 }
 
 /// True if nothing blocks the segment from the surface point to `target`.
-fn visible<S: SpawnScalar>(
-    r: &Renderer<'_, S>,
+fn visible<S: SpawnScalar, F: AccelFamily<S>>(
+    r: &Renderer<'_, S, F>,
     sp: &SurfacePoint<'_, S>,
     target: [f32; 3],
     time: f32,

@@ -19,23 +19,27 @@
 mod camera;
 mod geometry;
 mod integrator;
+mod lights;
+mod memory;
+mod motion;
+mod objects;
 pub mod sampling;
 mod scene;
 pub mod scenes;
 mod srgb;
+mod surface;
 
-pub use geometry::{
-    memory_needed, AccelMemory, MemoryNeeded, ObjectSlot, MAX_LIGHTS, SPHERE_SPAWN_FACTOR,
-};
+pub use lights::MAX_LIGHTS;
+pub use memory::{memory_needed, RenderMemory, RenderMemoryNeeded};
+pub use objects::ObjectSlot;
 pub use sampling::SamplerKind;
 pub use scene::{
     Camera, Filter, Item, Light, Material, Object, Problem, Rgb, Scene, SceneError, Settings, Shape,
 };
 pub use srgb::encode_srgb8;
+pub use surface::SPHERE_SPAWN_FACTOR;
 
-use crate::accel::bvh::BuildOptions;
-use crate::accel::grid::GridOptions;
-use crate::accel::kdtree::KdOptions;
+use crate::accel::{AccelFamily, AnyFamily};
 use crate::geom::spawn::SpawnScalar;
 use crate::geom::Ray;
 use camera::CameraFrame;
@@ -43,26 +47,6 @@ use core::fmt;
 use geometry::Geometry;
 use glam::Vec3;
 use sampling::Sampler;
-
-/// Which accelerator every object is built into. Every choice gives the same image, bit for
-/// bit (the accelerators return the same closest hit, ties to the lowest id).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum AccelChoice {
-    /// Brute force (no memory needed): the reference.
-    Linear,
-    /// A BVH per object: [`AccelMemory::bvh_nodes`] and [`AccelMemory::words`] (primitive ids).
-    Bvh(BuildOptions),
-    /// A uniform grid per object: [`AccelMemory::words`] (cell offsets and references).
-    Grid(GridOptions),
-    /// A kd-tree per object: [`AccelMemory::kd_nodes`] and [`AccelMemory::words`] (references).
-    KdTree(KdOptions),
-}
-
-impl Default for AccelChoice {
-    fn default() -> Self {
-        Self::Bvh(BuildOptions::default())
-    }
-}
 
 /// What a render will do, derived once from the scene and settings. Features marked `false`
 /// are skipped entirely (no samples drawn, no rays cast).
@@ -226,10 +210,13 @@ impl RenderStats {
     }
 }
 
-/// A checked scene with its accelerators built, ready to render tiles.
+/// A checked scene with its accelerators built, ready to render tiles. Every object's
+/// accelerator is of the family `F`: [`AnyFamily`] chooses at run time; naming one structure's
+/// family links that structure alone. Every family gives the same image, bit for bit (the
+/// accelerators return the same closest hit, ties to the lowest id).
 #[derive(Clone, Debug)]
-pub struct Renderer<'a, S: SpawnScalar> {
-    geometry: Geometry<'a, S>,
+pub struct Renderer<'a, S: SpawnScalar, F: AccelFamily<S> = AnyFamily> {
+    geometry: Geometry<'a, S, F>,
     materials: &'a [Material],
     lights: &'a [Light],
     background: Rgb,
@@ -243,10 +230,9 @@ pub struct Renderer<'a, S: SpawnScalar> {
     plan: RenderPlan,
 }
 
-impl<'a, S: SpawnScalar> Renderer<'a, S> {
-    /// Checks the scene and settings, builds the accelerators into `memory` (at least what
-    /// [`memory_needed`] gives for `accel`; [`AccelMemory::default`], empty, for `Linear`) and derives the
-    /// plan.
+impl<'a, S: SpawnScalar, F: AccelFamily<S>> Renderer<'a, S, F> {
+    /// Checks the scene and settings, builds every object's accelerator with `accel` into
+    /// `memory` (at least what [`memory_needed`] gives) and derives the plan.
     ///
     /// # Errors
     /// A [`SceneError`] naming the item, its index, the field and the problem: bad settings,
@@ -255,15 +241,15 @@ impl<'a, S: SpawnScalar> Renderer<'a, S> {
     pub fn new(
         scene: &Scene<'a, S>,
         settings: Settings,
-        accel: AccelChoice,
-        memory: AccelMemory<'a, S>,
+        accel: F::Options,
+        memory: RenderMemory<'a, S, F>,
     ) -> Result<Self, SceneError> {
         check_settings(&settings)?;
         check_materials(scene)?;
         let camera = CameraFrame::new(&scene.camera, settings.width, settings.height)?;
         scene::check_rgb(scene.background, false)
             .map_err(|p| SceneError::new(Item::Settings, 0, "background", p))?;
-        let geometry = Geometry::build(scene.objects, scene.lights, accel, memory)?;
+        let geometry = Geometry::build(scene.objects, scene.lights, &accel, memory)?;
         Ok(Self {
             geometry,
             materials: scene.materials,

@@ -294,6 +294,9 @@ pub enum Problem {
     },
     /// A primitive could not be built into the accelerator.
     Build(crate::accel::BuildError),
+    /// A kind of primitive this renderer's accelerator family leaves out
+    /// ([`crate::AccelFamily::SPHERES`]).
+    NotLinked,
 }
 
 /// Bad scene data, settings or render call: which item, which field, and what is wrong.
@@ -343,6 +346,7 @@ impl fmt::Display for Problem {
                 write!(f, "buffer too small: need {needed} slots, have {available}")
             }
             Self::Build(e) => write!(f, "{e}"),
+            Self::NotLinked => write!(f, "this renderer is built without this kind of primitive"),
         }
     }
 }

@@ -8,21 +8,20 @@
 //! (`cargo xtask panic-check`). Never run: it only has to link.
 
 use core::hint::black_box;
-use raykernel::bvh::BuildOptions;
 use raykernel::render::scenes::{self, SceneData};
 use raykernel::render::{
-    encode_srgb8, memory_needed, AccelChoice, AccelMemory, Object, ObjectSlot, RenderStats,
-    Renderer, Settings, Shape, Tile,
+    encode_srgb8, memory_needed, Object, ObjectSlot, RenderMemory, RenderStats, Renderer, Settings,
+    Shape, Tile,
 };
 use raykernel::spawn::SpawnScalar;
-use raykernel::{grid::GridOptions, kdtree::KdOptions, KdNode, Node, Sphere, Triangle};
+use raykernel::{AccelKind, AccelMemory, AnyFamily, KdNode, Node, Node4, Sphere, Triangle};
 
 const TRIS: usize = 24;
 const SPHERES: usize = 4;
 const OBJECTS: usize = 8;
 const WORDS: usize = 512;
 
-fn exercise<S: SpawnScalar>(data: &SceneData<'_>, settings: Settings, accel: AccelChoice) {
+fn exercise<S: SpawnScalar>(data: &SceneData<'_>, settings: Settings, accel: AccelKind) {
     let mut tris = [Triangle::<S> {
         v: [[S::ZERO; 3]; 3],
     }; TRIS];
@@ -39,17 +38,21 @@ fn exercise<S: SpawnScalar>(data: &SceneData<'_>, settings: Settings, accel: Acc
     let Ok(scene) = data.scene(tris, spheres, &mut objects) else {
         return;
     };
-    black_box(memory_needed(scene.objects, accel).bytes::<S>());
-    let mut slots = [ObjectSlot::EMPTY; OBJECTS];
-    let mut bvh_nodes = [Node::<S>::EMPTY; 2 * (TRIS + SPHERES) + 2 * OBJECTS];
+    black_box(memory_needed::<S, AnyFamily>(scene.objects, &accel).bytes::<S, AnyFamily>());
+    let mut slots = [ObjectSlot::<S>::EMPTY; OBJECTS];
+    let mut nodes = [Node::<S>::EMPTY; 2 * (TRIS + SPHERES) + 4 * OBJECTS];
+    let mut nodes4 = [Node4::<S>::EMPTY; TRIS + SPHERES + OBJECTS];
     let mut kd_nodes = [KdNode::<S>::EMPTY; 4 * (TRIS + SPHERES) + OBJECTS];
     let mut words = [0u32; WORDS];
     let n = black_box(usize::MAX);
-    let memory = AccelMemory {
+    let memory = RenderMemory {
         objects: &mut slots[..n.min(OBJECTS)],
-        bvh_nodes: &mut bvh_nodes[..n.min(2 * (TRIS + SPHERES) + 2 * OBJECTS)],
-        kd_nodes: &mut kd_nodes[..n.min(4 * (TRIS + SPHERES) + OBJECTS)],
-        words: &mut words[..n.min(WORDS)],
+        accel: AccelMemory {
+            nodes: &mut nodes[..n.min(2 * (TRIS + SPHERES) + 4 * OBJECTS)],
+            nodes4: &mut nodes4[..n.min(TRIS + SPHERES + OBJECTS)],
+            kd_nodes: &mut kd_nodes[..n.min(4 * (TRIS + SPHERES) + OBJECTS)],
+            words: &mut words[..n.min(WORDS)],
+        },
     };
     let Ok(r) = Renderer::new(&scene, settings, accel, memory) else {
         return;
@@ -78,13 +81,7 @@ fn exercise<S: SpawnScalar>(data: &SceneData<'_>, settings: Settings, accel: Acc
 pub fn run<S: SpawnScalar>() -> ! {
     let data = black_box(&scenes::CORNELL);
     let settings = black_box(data.settings);
-    let accels = [
-        AccelChoice::Linear,
-        AccelChoice::Bvh(black_box(BuildOptions::default())),
-        AccelChoice::Grid(black_box(GridOptions::default())),
-        AccelChoice::KdTree(black_box(KdOptions::default())),
-    ];
-    for accel in black_box(accels) {
+    for accel in black_box(AccelKind::ALL) {
         exercise::<S>(data, settings, accel);
     }
     black_box(encode_srgb8(black_box(0.5)));

@@ -7,7 +7,7 @@ use super::{
     nodes_needed, BuildOptions, BuilderKind, Node, FIRST_PAIR, MAX_DEPTH, MAX_LEAF_SIZE,
     MEDIAN_FALLBACK_DEPTH,
 };
-use crate::accel::{Arena, BuildError};
+use crate::accel::{check_count, check_each, Arena, BuildError};
 use crate::geom::{Aabb, Primitive};
 use crate::scalar::lanes::F4;
 use crate::scalar::Scalar;
@@ -50,9 +50,7 @@ fn split_top_down<S: Scalar, P: Primitive<S>>(
     options: BuildOptions,
 ) -> Result<(usize, u32), BuildError> {
     let n = prims.len();
-    if n >= u32::MAX as usize {
-        return Err(BuildError::TooManyPrims { count: n });
-    }
+    check_count(n)?;
     if options.max_leaf_size == 0 || options.max_leaf_size > MAX_LEAF_SIZE {
         return Err(BuildError::BadLeafSize {
             max_leaf_size: options.max_leaf_size,
@@ -73,14 +71,7 @@ fn split_top_down<S: Scalar, P: Primitive<S>>(
             available: ids.len(),
         });
     }
-    for (prim, p) in prims.iter().enumerate() {
-        p.check()
-            .map_err(|(vertex, error)| BuildError::BadPrimitive {
-                prim,
-                vertex,
-                error,
-            })?;
-    }
+    check_each(prims)?;
     if n == 0 {
         return Ok((0, 0));
     }

@@ -20,6 +20,7 @@ mod refit;
 mod select;
 mod traverse;
 mod validate;
+mod walk;
 
 pub use node::Node;
 pub(crate) use refit::{check_prims, leaf_bounds};
@@ -177,8 +178,7 @@ impl<'a, S: Scalar, P: Primitive<S>> Bvh<'a, S, P> {
     /// report original indices, and ties still go to the lowest original index.
     ///
     /// # Errors
-    /// As [`Bvh::build`]; also [`BuildError::TooManyPrims`] above `2^31 - 1` primitives (the
-    /// permutation marks visited ids in their top bit).
+    /// As [`Bvh::build`].
     pub fn build_in_leaf_order(
         prims: &'a mut [P],
         nodes: &'a mut [Node<S>],
@@ -188,10 +188,9 @@ impl<'a, S: Scalar, P: Primitive<S>> Bvh<'a, S, P> {
     where
         P: Copy,
     {
+        // Marks visited ids; free, as ids stay below `MAX_PRIMS`.
         const MARK: u32 = 1 << 31;
-        if prims.len() >= MARK as usize {
-            return Err(BuildError::TooManyPrims { count: prims.len() });
-        }
+        const _: () = assert!(crate::accel::MAX_PRIMS < MARK as usize);
         let (node_count, depth) = build::build(prims, nodes, prim_ids, options)?;
         let available = prim_ids.len();
         let Some(ids) = prim_ids.get_mut(..prims.len()) else {

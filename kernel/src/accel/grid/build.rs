@@ -1,7 +1,7 @@
 //! Grid construction: bounds, resolution, counting pass, fill pass; and the checker.
 
 use super::{Grid, GridOptions, GridSize, GridStats, InvalidGrid, Layout, MAX_DENSITY, MAX_RES};
-use crate::accel::{Arena, BuildError};
+use crate::accel::{check_count, check_each, Arena, BuildError};
 use crate::geom::{Aabb, Primitive};
 use crate::scalar::Scalar;
 
@@ -19,21 +19,12 @@ fn layout<S: Scalar, P: Primitive<S>>(
     options: GridOptions,
 ) -> Result<Option<Layout<S>>, BuildError> {
     let n = prims.len();
-    if n >= u32::MAX as usize {
-        return Err(BuildError::TooManyPrims { count: n });
-    }
+    check_count(n)?;
     let density = options.density;
     if !(density > 0.0 && density <= MAX_DENSITY) {
         return Err(BuildError::BadDensity { density });
     }
-    for (prim, p) in prims.iter().enumerate() {
-        p.check()
-            .map_err(|(vertex, error)| BuildError::BadPrimitive {
-                prim,
-                vertex,
-                error,
-            })?;
-    }
+    check_each(prims)?;
     let Some(first) = prims.first() else {
         return Ok(None);
     };

@@ -3,7 +3,7 @@
 use super::{
     nodes_needed, refs_needed, InvalidKdTree, KdNode, KdOptions, KdStats, KdTree, MAX_DEPTH,
 };
-use crate::accel::{Arena, BuildError};
+use crate::accel::{check_count, check_each, Arena, BuildError};
 use crate::geom::{Aabb, Primitive};
 use crate::scalar::Scalar;
 
@@ -15,8 +15,6 @@ const TRAVERSAL_COST: f32 = 2.0;
 const INTERSECT_COST: f32 = 1.5;
 /// Discount on the split cost when one side is empty (cutting off empty space).
 const EMPTY_BONUS: f32 = 0.2;
-/// Most primitives the tree may hold: node and reference indices must fit 30 bits.
-const MAX_PRIMS: usize = 1 << 28;
 
 /// What the build produced.
 pub(super) struct Built<S: Scalar> {
@@ -79,9 +77,7 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
     options: KdOptions,
 ) -> Result<Built<S>, BuildError> {
     let n = prims.len();
-    if n > MAX_PRIMS {
-        return Err(BuildError::TooManyPrims { count: n });
-    }
+    check_count(n)?;
     if options.max_depth > MAX_DEPTH {
         return Err(BuildError::BadMaxDepth {
             max_depth: options.max_depth,
@@ -103,14 +99,7 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
             available: refs.len(),
         });
     }
-    for (prim, p) in prims.iter().enumerate() {
-        p.check()
-            .map_err(|(vertex, error)| BuildError::BadPrimitive {
-                prim,
-                vertex,
-                error,
-            })?;
-    }
+    check_each(prims)?;
     let empty = Built {
         nodes: 0,
         refs: 0,

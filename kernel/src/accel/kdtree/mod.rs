@@ -159,7 +159,7 @@ impl<'a, S: Scalar, P: Primitive<S>> KdTree<'a, S, P> {
     ///
     /// # Errors
     /// [`BuildError::ArenaTooSmall`] with the exact budgets, [`BuildError::TooManyPrims`]
-    /// (above `2^28` primitives, so that indices fit the node word), [`BuildError::BadPrimitive`]
+    /// (above [`crate::MAX_PRIMS`]), [`BuildError::BadPrimitive`]
     /// and [`BuildError::BadMaxDepth`].
     pub fn build(
         prims: &'a [P],

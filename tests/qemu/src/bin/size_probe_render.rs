@@ -1,4 +1,5 @@
-//! Size probe of the renderer: the default built-in scene (`f32`, one BVH per object) converted
+//! Size probe of the renderer: the default built-in scene (`f32`, the BVH family: one BVH per
+//! object, no other structure linked) converted
 //! into caller buffers, `Renderer::new`, and one row rendered to sRGB bytes; nothing else (no
 //! defmt, a spinning panic handler). `cargo xtask size` reports its `.text`/`.rodata` next to
 //! the build + traverse probe (`size_probe.rs`) and runs it under QEMU to measure its stack (the
@@ -11,8 +12,8 @@ use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m_rt::entry;
 use raykernel::bvh::{nodes_needed, BuildOptions};
 use raykernel::render::scenes::{self, SceneData};
-use raykernel::render::{AccelChoice, AccelMemory, Object, ObjectSlot, Renderer, Shape, Tile};
-use raykernel::{Node, Sphere, Triangle};
+use raykernel::render::{Object, ObjectSlot, RenderMemory, Renderer, Shape, Tile};
+use raykernel::{AccelMemory, BvhFamily, Node, Sphere, Triangle};
 
 const TRIS: usize = 24;
 const SPHERES: usize = 4;
@@ -38,17 +39,26 @@ fn render_row(data: &SceneData<'_>) -> Option<()> {
     data.spheres_into(spheres).ok()?;
     let mut objects = [Object::new(Shape::Triangles(&[]), 0); OBJECTS];
     let scene = data.scene(tris, spheres, &mut objects).ok()?;
-    let mut slots = [ObjectSlot::EMPTY; OBJECTS];
-    let mut nodes = [Node::<f32>::EMPTY; nodes_needed(TRIS) + nodes_needed(SPHERES) + 2 * OBJECTS];
-    let mut ids = [0u32; TRIS + SPHERES];
-    let memory = AccelMemory {
+    // The BVH family: no other structure is linked.
+    let mut slots = [ObjectSlot::<f32, BvhFamily>::EMPTY; OBJECTS];
+    // Every object's BVH, then the top-level BVH over the objects.
+    let mut nodes = [Node::<f32>::EMPTY; nodes_needed(TRIS) + nodes_needed(SPHERES) + 4 * OBJECTS];
+    let mut ids = [0u32; TRIS + SPHERES + OBJECTS];
+    let memory = RenderMemory {
         objects: &mut slots,
-        bvh_nodes: &mut nodes,
-        kd_nodes: &mut [],
-        words: &mut ids,
+        accel: AccelMemory {
+            nodes: &mut nodes,
+            words: &mut ids,
+            ..AccelMemory::default()
+        },
     };
-    let accel = AccelChoice::Bvh(black_box(BuildOptions::default()));
-    let r = Renderer::new(&scene, data.settings, accel, memory).ok()?;
+    let r = Renderer::new(
+        &scene,
+        data.settings,
+        black_box(BuildOptions::default()),
+        memory,
+    )
+    .ok()?;
     let mut row = [0u8; 3 * WIDTH];
     let tile = Tile {
         x: 0,

@@ -1,0 +1,234 @@
+//! Accelerator families: a structure chosen at compile time, so that code generic over a
+//! family (the renderer) links that structure alone. [`AnyFamily`] is the run-time choice.
+
+use super::any::AnyAccel;
+use super::bvh::{BuildOptions, Bvh};
+use super::bvh4::Bvh4;
+use super::grid::{Grid, GridOptions};
+use super::kdtree::{KdOptions, KdTree};
+use super::memory::take;
+use super::{
+    check_count, check_each, Accel, AccelKind, AccelMemory, BuildError, Linear, MemoryNeeded,
+};
+use crate::geom::Primitive;
+use crate::scalar::Scalar;
+use core::fmt::Debug;
+use core::marker::PhantomData;
+
+/// A kind of accelerator, named at compile time: what it builds over primitives `P`, with which
+/// run-time options, into how much memory.
+pub trait AccelFamily<S: Scalar>: Copy + Debug + 'static {
+    /// The built structure over primitives `P`.
+    type Accel<'a, P: Primitive<S> + 'a>: Accel<S> + Copy + Debug;
+    /// What the caller chooses at run time.
+    type Options: Copy + Debug + PartialEq;
+    /// Whether code generic over the family handles spheres. With `false`, sphere arms are
+    /// constant-false branches (dead code) and sphere inputs are refused.
+    const SPHERES: bool = true;
+
+    /// The exact memory [`AccelFamily::build`] takes over `prims`.
+    ///
+    /// # Errors
+    /// [`BuildError::TooManyPrims`], and what a counting pass rejects.
+    fn memory_needed<P: Primitive<S>>(
+        options: &Self::Options,
+        prims: &[P],
+    ) -> Result<MemoryNeeded, BuildError>;
+
+    /// Builds over `prims`, taking [`AccelFamily::memory_needed`] from the front of `memory`.
+    ///
+    /// # Errors
+    /// What the structure's builder reports.
+    fn build<'a, P: Primitive<S> + 'a>(
+        options: &Self::Options,
+        prims: &'a [P],
+        memory: &mut AccelMemory<'a, S>,
+    ) -> Result<Self::Accel<'a, P>, BuildError>;
+}
+
+/// Any structure, chosen at run time by an [`AccelKind`]: [`AnyAccel`].
+#[derive(Clone, Copy, Debug)]
+pub struct AnyFamily;
+
+/// Brute force, [`Linear`].
+#[derive(Clone, Copy, Debug)]
+pub struct LinearFamily;
+
+/// The binary BVH, [`Bvh`].
+#[derive(Clone, Copy, Debug)]
+pub struct BvhFamily;
+
+/// The 4-wide BVH, [`Bvh4`].
+#[derive(Clone, Copy, Debug)]
+pub struct Bvh4Family;
+
+/// The uniform grid, [`Grid`].
+#[derive(Clone, Copy, Debug)]
+pub struct GridFamily;
+
+/// The kd-tree, [`KdTree`].
+#[derive(Clone, Copy, Debug)]
+pub struct KdTreeFamily;
+
+/// Family `F` for scenes of triangles only: spheres are not linked ([`AccelFamily::SPHERES`]).
+#[derive(Clone, Copy, Debug)]
+pub struct TrianglesOnly<F>(PhantomData<F>);
+
+impl<S: Scalar> AccelFamily<S> for AnyFamily {
+    type Accel<'a, P: Primitive<S> + 'a> = AnyAccel<'a, S, P>;
+    type Options = AccelKind;
+
+    fn memory_needed<P: Primitive<S>>(
+        kind: &AccelKind,
+        prims: &[P],
+    ) -> Result<MemoryNeeded, BuildError> {
+        kind.memory_needed(prims)
+    }
+
+    fn build<'a, P: Primitive<S> + 'a>(
+        kind: &AccelKind,
+        prims: &'a [P],
+        memory: &mut AccelMemory<'a, S>,
+    ) -> Result<AnyAccel<'a, S, P>, BuildError> {
+        AnyAccel::build(*kind, prims, memory)
+    }
+}
+
+impl<S: Scalar> AccelFamily<S> for LinearFamily {
+    type Accel<'a, P: Primitive<S> + 'a> = Linear<'a, S, P>;
+    type Options = ();
+
+    fn memory_needed<P: Primitive<S>>(_: &(), prims: &[P]) -> Result<MemoryNeeded, BuildError> {
+        check_count(prims.len())?;
+        Ok(MemoryNeeded::NONE)
+    }
+
+    fn build<'a, P: Primitive<S> + 'a>(
+        _: &(),
+        prims: &'a [P],
+        _: &mut AccelMemory<'a, S>,
+    ) -> Result<Linear<'a, S, P>, BuildError> {
+        check_count(prims.len())?;
+        check_each(prims)?;
+        Ok(Linear::new(prims))
+    }
+}
+
+impl<S: Scalar> AccelFamily<S> for BvhFamily {
+    type Accel<'a, P: Primitive<S> + 'a> = Bvh<'a, S, P>;
+    type Options = BuildOptions;
+
+    fn memory_needed<P: Primitive<S>>(
+        _: &BuildOptions,
+        prims: &[P],
+    ) -> Result<MemoryNeeded, BuildError> {
+        check_count(prims.len())?;
+        Ok(MemoryNeeded::bvh(prims.len()))
+    }
+
+    fn build<'a, P: Primitive<S> + 'a>(
+        options: &BuildOptions,
+        prims: &'a [P],
+        memory: &mut AccelMemory<'a, S>,
+    ) -> Result<Bvh<'a, S, P>, BuildError> {
+        let need = MemoryNeeded::bvh(prims.len());
+        let nodes = take(&mut memory.nodes, need.nodes);
+        let ids = take(&mut memory.words, need.words);
+        Bvh::build(prims, nodes, ids, *options)
+    }
+}
+
+impl<S: Scalar> AccelFamily<S> for Bvh4Family {
+    type Accel<'a, P: Primitive<S> + 'a> = Bvh4<'a, S, P>;
+    type Options = BuildOptions;
+
+    fn memory_needed<P: Primitive<S>>(
+        _: &BuildOptions,
+        prims: &[P],
+    ) -> Result<MemoryNeeded, BuildError> {
+        check_count(prims.len())?;
+        Ok(MemoryNeeded::bvh4(prims.len()))
+    }
+
+    fn build<'a, P: Primitive<S> + 'a>(
+        options: &BuildOptions,
+        prims: &'a [P],
+        memory: &mut AccelMemory<'a, S>,
+    ) -> Result<Bvh4<'a, S, P>, BuildError> {
+        let need = MemoryNeeded::bvh4(prims.len());
+        let nodes = take(&mut memory.nodes, need.nodes);
+        let ids = take(&mut memory.words, need.words);
+        let nodes4 = take(&mut memory.nodes4, need.nodes4);
+        let binary = Bvh::build(prims, nodes, ids, *options)?;
+        Bvh4::collapse(&binary, nodes4)
+    }
+}
+
+impl<S: Scalar> AccelFamily<S> for GridFamily {
+    type Accel<'a, P: Primitive<S> + 'a> = Grid<'a, S, P>;
+    type Options = GridOptions;
+
+    fn memory_needed<P: Primitive<S>>(
+        options: &GridOptions,
+        prims: &[P],
+    ) -> Result<MemoryNeeded, BuildError> {
+        let size = Grid::<S, P>::size_for(prims, *options)?;
+        Ok(MemoryNeeded::grid(size))
+    }
+
+    fn build<'a, P: Primitive<S> + 'a>(
+        options: &GridOptions,
+        prims: &'a [P],
+        memory: &mut AccelMemory<'a, S>,
+    ) -> Result<Grid<'a, S, P>, BuildError> {
+        let size = Grid::<S, P>::size_for(prims, *options)?;
+        let cells = take(&mut memory.words, size.cells);
+        let refs = take(&mut memory.words, size.refs);
+        Grid::build(prims, cells, refs, *options)
+    }
+}
+
+impl<S: Scalar> AccelFamily<S> for KdTreeFamily {
+    type Accel<'a, P: Primitive<S> + 'a> = KdTree<'a, S, P>;
+    type Options = KdOptions;
+
+    fn memory_needed<P: Primitive<S>>(
+        _: &KdOptions,
+        prims: &[P],
+    ) -> Result<MemoryNeeded, BuildError> {
+        check_count(prims.len())?;
+        Ok(MemoryNeeded::kdtree(prims.len()))
+    }
+
+    fn build<'a, P: Primitive<S> + 'a>(
+        options: &KdOptions,
+        prims: &'a [P],
+        memory: &mut AccelMemory<'a, S>,
+    ) -> Result<KdTree<'a, S, P>, BuildError> {
+        let need = MemoryNeeded::kdtree(prims.len());
+        let nodes = take(&mut memory.kd_nodes, need.kd_nodes);
+        let refs = take(&mut memory.words, need.words);
+        KdTree::build(prims, nodes, refs, *options)
+    }
+}
+
+impl<S: Scalar, F: AccelFamily<S>> AccelFamily<S> for TrianglesOnly<F> {
+    type Accel<'a, P: Primitive<S> + 'a> = F::Accel<'a, P>;
+    type Options = F::Options;
+    const SPHERES: bool = false;
+
+    fn memory_needed<P: Primitive<S>>(
+        options: &F::Options,
+        prims: &[P],
+    ) -> Result<MemoryNeeded, BuildError> {
+        F::memory_needed(options, prims)
+    }
+
+    fn build<'a, P: Primitive<S> + 'a>(
+        options: &F::Options,
+        prims: &'a [P],
+        memory: &mut AccelMemory<'a, S>,
+    ) -> Result<F::Accel<'a, P>, BuildError> {
+        F::build(options, prims, memory)
+    }
+}

@@ -1,0 +1,165 @@
+//! The caller's memory for accelerators, and how much of it a build takes.
+
+use super::bvh::{nodes_needed, Node};
+use super::bvh4::{nodes4_needed, Node4};
+use super::grid::GridSize;
+use super::kdtree::{self, KdNode};
+use crate::scalar::Scalar;
+
+/// Memory for accelerator builds: one buffer per element type. A build takes its share from
+/// the front of each buffer and leaves the rest, so one value serves a sequence of builds
+/// (the renderer builds every object into one). Longer buffers than needed are fine.
+#[derive(Debug)]
+pub struct AccelMemory<'a, S: Scalar> {
+    /// Binary BVH nodes (the 4-wide BVH's build takes them too, as scratch).
+    pub nodes: &'a mut [Node<S>],
+    /// 4-wide BVH nodes.
+    pub nodes4: &'a mut [Node4<S>],
+    /// Kd-tree nodes.
+    pub kd_nodes: &'a mut [KdNode<S>],
+    /// Index words: BVH primitive ids, grid cell offsets and references, kd-tree references.
+    pub words: &'a mut [u32],
+}
+
+impl<S: Scalar> Default for AccelMemory<'_, S> {
+    /// No memory at all: enough for brute force and for empty inputs.
+    fn default() -> Self {
+        Self {
+            nodes: &mut [],
+            nodes4: &mut [],
+            kd_nodes: &mut [],
+            words: &mut [],
+        }
+    }
+}
+
+/// Takes the first `n` slots of a buffer (all of them if it is shorter), leaving the rest.
+pub(crate) fn take<'a, T>(buf: &mut &'a mut [T], n: usize) -> &'a mut [T] {
+    let all = core::mem::take(buf);
+    let n = n.min(all.len());
+    let (mine, rest) = all.split_at_mut(n);
+    *buf = rest;
+    mine
+}
+
+impl<S: Scalar> AccelMemory<'_, S> {
+    /// The buffers' lengths, in the form [`MemoryNeeded`] states requirements.
+    #[must_use]
+    pub fn available(&self) -> MemoryNeeded {
+        MemoryNeeded {
+            nodes: self.nodes.len(),
+            nodes4: self.nodes4.len(),
+            kd_nodes: self.kd_nodes.len(),
+            words: self.words.len(),
+        }
+    }
+}
+
+/// Buffer lengths (elements, not bytes) of an [`AccelMemory`] that a build takes, exact:
+/// from [`crate::AccelKind::memory_needed`] or, when the count alone decides,
+/// [`crate::AccelKind::memory_for_count`] in `const` context.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MemoryNeeded {
+    /// Length of [`AccelMemory::nodes`].
+    pub nodes: usize,
+    /// Length of [`AccelMemory::nodes4`].
+    pub nodes4: usize,
+    /// Length of [`AccelMemory::kd_nodes`].
+    pub kd_nodes: usize,
+    /// Length of [`AccelMemory::words`].
+    pub words: usize,
+}
+
+impl MemoryNeeded {
+    /// Nothing.
+    pub const NONE: Self = Self {
+        nodes: 0,
+        nodes4: 0,
+        kd_nodes: 0,
+        words: 0,
+    };
+
+    /// A binary BVH over `count` primitives: [`nodes_needed`] nodes, one word per primitive id.
+    #[must_use]
+    pub const fn bvh(count: usize) -> Self {
+        Self {
+            nodes: nodes_needed(count),
+            words: count,
+            ..Self::NONE
+        }
+    }
+
+    /// A 4-wide BVH over `count` primitives: the binary BVH it is collapsed from (its nodes
+    /// are build scratch) and [`nodes4_needed`] wide nodes.
+    #[must_use]
+    pub const fn bvh4(count: usize) -> Self {
+        Self {
+            nodes4: nodes4_needed(count),
+            ..Self::bvh(count)
+        }
+    }
+
+    /// A kd-tree over `count` primitives: its node and reference budgets.
+    #[must_use]
+    pub const fn kdtree(count: usize) -> Self {
+        Self {
+            kd_nodes: kdtree::nodes_needed(count),
+            words: kdtree::refs_needed(count),
+            ..Self::NONE
+        }
+    }
+
+    /// A uniform grid of the size its counting pass found: cell offsets and references.
+    #[must_use]
+    pub const fn grid(size: GridSize) -> Self {
+        Self {
+            words: size.cells.saturating_add(size.refs),
+            ..Self::NONE
+        }
+    }
+
+    /// What two builds take together.
+    #[must_use]
+    pub const fn add(self, o: Self) -> Self {
+        Self {
+            nodes: self.nodes.saturating_add(o.nodes),
+            nodes4: self.nodes4.saturating_add(o.nodes4),
+            kd_nodes: self.kd_nodes.saturating_add(o.kd_nodes),
+            words: self.words.saturating_add(o.words),
+        }
+    }
+
+    /// The total in bytes for mode `S`.
+    #[must_use]
+    pub const fn bytes<S: Scalar>(&self) -> usize {
+        self.nodes
+            .saturating_mul(size_of::<Node<S>>())
+            .saturating_add(self.nodes4.saturating_mul(size_of::<Node4<S>>()))
+            .saturating_add(self.kd_nodes.saturating_mul(size_of::<KdNode<S>>()))
+            .saturating_add(self.words.saturating_mul(4))
+    }
+
+    /// The first buffer shorter in `available` than required here: its field name, the
+    /// length needed and the length available.
+    #[must_use]
+    pub const fn first_shortfall(
+        &self,
+        available: &MemoryNeeded,
+    ) -> Option<(&'static str, usize, usize)> {
+        let pairs = [
+            ("nodes", self.nodes, available.nodes),
+            ("nodes4", self.nodes4, available.nodes4),
+            ("kd_nodes", self.kd_nodes, available.kd_nodes),
+            ("words", self.words, available.words),
+        ];
+        let mut i = 0;
+        while i < pairs.len() {
+            let (field, needed, have) = pairs[i];
+            if have < needed {
+                return Some((field, needed, have));
+            }
+            i += 1;
+        }
+        None
+    }
+}
