@@ -43,9 +43,12 @@ fn sponza_slivers_are_hit_with_accurate_t() {
 }
 
 /// Found by the fuzz target `accel_equivalence`: a ray through a vertex of a triangle with
-/// subnormal coordinates got `v = -9.7e-44` (the f64 solve's sign disagreed with the f32 edge
-/// functions that accepted the hit). Barycentrics of a hit are now clamped to `[0, 1]`, as the
-/// fixed-point mode already did.
+/// subnormal coordinates got `v = -9.7e-44` (the candidate solve's sign disagreed with the f32
+/// edge functions that accepted the hit). Barycentrics of a hit are now clamped to `[0, 1]`, as
+/// the fixed-point mode already did. The exact edge functions decide that the fuzzer's own
+/// ray passes just outside the vertex, so the rays tried sweep its direction over 64 ulps
+/// each way and start at the origin or behind vertex 1 along themselves: some hit, and every
+/// hit's barycentrics lie in `[0, 1]`.
 #[test]
 fn barycentrics_of_a_hit_stay_in_unit_interval() {
     let tri = Triangle::<f32>::from_f32([
@@ -54,18 +57,24 @@ fn barycentrics_of_a_hit_stay_in_unit_interval() {
         [8192.0, 8192.0, 8192.0],
     ])
     .unwrap();
-    let ray = Ray::<f32>::from_f32(
-        [0.0, 0.0, 0.0],
-        [0.99999523, -0.0030822607, -3.1424604e-26],
-        0.0,
-        f32::INFINITY,
-    )
-    .unwrap();
-    let (t, u, v) = tri
-        .intersect(&ray)
-        .expect("the ray passes through vertex 1");
-    assert!(t >= 0.0);
-    for w in [u, v] {
-        assert!((0.0..=1.0).contains(&w), "barycentric {w} (u {u}, v {v})");
+    let d = [0.99999523f32, -0.0030822607, -3.1424604e-26];
+    let mut hits = 0;
+    for step in -64i32..=64 {
+        let dy = f32::from_bits((d[1].to_bits() as i32 + step) as u32);
+        // From the origin, and from points behind vertex 1 along the ray.
+        let back = [0.0, 1e-36, 1e-30, 1e-20, 1e-3][(step & 3) as usize + (step == 0) as usize];
+        let o = [-back * d[0], -back * dy, -back * d[2]];
+        let ray = Ray::<f32>::from_f32(o, [d[0], dy, d[2]], 0.0, f32::INFINITY).unwrap();
+        if let Some((t, u, v)) = tri.intersect(&ray) {
+            hits += 1;
+            assert!(t >= 0.0);
+            for w in [u, v] {
+                assert!(
+                    (0.0..=1.0).contains(&w),
+                    "barycentric {w} (u {u}, v {v}), y {dy:e}"
+                );
+            }
+        }
     }
+    assert!(hits > 0, "no ray of the sweep hits the triangle");
 }
