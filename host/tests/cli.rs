@@ -209,12 +209,6 @@ fn bad_arguments_are_usage_errors() {
     // --out is required.
     assert_fails(&host(&[&p("trace"), &obj, &rays]), 2, "--out");
     assert_fails(&host(&[&p("draw")]), 2, "unrecognized subcommand");
-    // The renderer has no 4-wide BVH.
-    assert_fails(
-        &host(&[&p("render"), &p("--accel"), &p("bvh4"), &p("--out"), &hits]),
-        2,
-        "--accel bvh4 is for `raykernel trace` only",
-    );
 }
 
 #[test]
