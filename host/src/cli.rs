@@ -108,6 +108,9 @@ pub struct RenderArgs {
     /// Also write the linear image (mean radiance per pixel, unclipped) as a PFM file.
     #[arg(long, value_name = "FILE.pfm")]
     pub linear: Option<PathBuf>,
+    /// Also write the linear image as an OpenEXR file (32-bit float RGB, the PFM's values).
+    #[arg(long, value_name = "FILE.exr")]
+    pub exr: Option<PathBuf>,
     /// Write the scene, with the settings this command would render it with, as a scene file.
     #[arg(long, value_name = "FILE.json")]
     pub dump_scene: Option<PathBuf>,
@@ -587,6 +590,9 @@ pub fn run_render(args: &RenderArgs) -> Result<RenderReport, Error> {
     if let Some(path) = &args.linear {
         write_pfm(path, &r.frame)?;
         report.linear = Some(path.display().to_string());
+    }
+    if let Some(path) = &args.exr {
+        crate::exr::write_exr(path, &r.frame)?;
     }
     report.out = Some(out.display().to_string());
     let rays = r.stats.rays();
