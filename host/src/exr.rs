@@ -3,30 +3,34 @@
 
 use crate::error::Error;
 use crate::render::Frame;
+use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
+use std::io::Cursor;
 use std::path::Path;
 
-/// Writes `frame` as an OpenEXR file with `R`, `G`, `B` channels of 32-bit floats.
+/// The OpenEXR bytes of `frame`: one layer with `R`, `G`, `B` channels of 32-bit floats.
 ///
 /// # Errors
-/// [`Error::Output`] if it cannot be encoded or written.
-pub fn write_exr(path: &Path, frame: &Frame) -> Result<(), Error> {
+/// The encoder's message if the frame cannot be encoded (its pixels do not match its size).
+pub fn encode_exr(frame: &Frame) -> Result<Vec<u8>, String> {
     let w = frame.width as usize;
-    let fail = |msg: String| Error::Output {
-        path: path.to_path_buf(),
-        msg,
-    };
-    if frame.linear.len() != w * frame.height as usize {
-        return Err(fail("frame size does not match its pixels".into()));
+    let h = frame.height as usize;
+    if frame.linear.len() != w * h {
+        return Err("frame size does not match its pixels".into());
     }
-    exr::prelude::write_rgb_file(path, w, frame.height as usize, |x, y| {
-        let [r, g, b] = frame.linear[y * w + x];
+    let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+        let [r, g, b] = frame.linear[p.y() * w + p.x()];
         (r, g, b)
-    })
-    .map_err(|e| fail(format!("cannot write OpenEXR: {e}")))
+    });
+    let mut bytes = Cursor::new(Vec::new());
+    Image::from_channels((w, h), channels)
+        .write()
+        .to_buffered(&mut bytes)
+        .map_err(|e| format!("cannot encode OpenEXR: {e}"))?;
+    Ok(bytes.into_inner())
 }
 
 /// Reads the RGB channels of an OpenEXR file's first layer as a frame (alpha, if any, is
-/// dropped): the inverse of [`write_exr`].
+/// dropped): the inverse of [`encode_exr`].
 ///
 /// # Errors
 /// [`Error::Output`] if the file cannot be read or is not an RGB(A) OpenEXR image.

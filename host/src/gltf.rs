@@ -12,6 +12,8 @@
 //! that panic is caught and reported as an error naming the file.
 
 use crate::error::Error;
+use crate::input::read_limited;
+use crate::limits::{MAX_MATERIALS, MAX_OBJ_FILE_BYTES, MAX_TRIANGLES};
 use crate::mtl::{split_by_material, MeshMaterials};
 use crate::scene::{lit_mesh_scene, PinholeCamera};
 use crate::spec::{ObjectSource, SceneSpec};
@@ -20,10 +22,8 @@ use gltf::mesh::Mode;
 use raykernel::render::Material;
 use std::path::Path;
 
-/// Largest `.gltf`/`.glb` file, and largest external buffer, read (bytes).
-pub const MAX_GLTF_BYTES: u64 = 1 << 30;
-/// Most triangles a glTF scene may expand to (instanced meshes count once per instance).
-pub const MAX_GLTF_TRIANGLES: usize = 1 << 25;
+/// Largest `.gltf`/`.glb` file, and largest external buffer, read (bytes): as for OBJ files.
+pub const MAX_GLTF_BYTES: u64 = MAX_OBJ_FILE_BYTES;
 
 /// A column-major 4×4 matrix, as glTF stores them.
 type Mat4 = [[f64; 4]; 4];
@@ -92,12 +92,15 @@ fn load(path: &Path) -> Result<SceneSpec, Error> {
                 let Some(corners) = primitive_triangles(&prim, &buffers).map_err(&fail)? else {
                     continue;
                 };
-                if triangles.len() + corners.len() > MAX_GLTF_TRIANGLES {
+                if triangles.len() + corners.len() > MAX_TRIANGLES {
                     return Err(fail(format!(
-                        "more than {MAX_GLTF_TRIANGLES} triangles (instances counted)"
+                        "more than {MAX_TRIANGLES} triangles (instances counted)"
                     )));
                 }
                 let m = materials.index_of(&prim.material());
+                if materials.names.len() > MAX_MATERIALS {
+                    return Err(fail(format!("more than {MAX_MATERIALS} materials")));
+                }
                 for tri in corners {
                     triangles.push(tri.map(|p| transform_point(&world, p)));
                     of_triangle.push(m);
@@ -350,17 +353,7 @@ fn percent_decode(uri: &str) -> String {
 
 /// Reads a regular file of at most [`MAX_GLTF_BYTES`].
 fn read_capped(path: &Path) -> Result<Vec<u8>, String> {
-    let meta = std::fs::metadata(path).map_err(|e| format!("cannot read: {e}"))?;
-    if !meta.is_file() {
-        return Err("not a regular file".into());
-    }
-    if meta.len() > MAX_GLTF_BYTES {
-        return Err(format!(
-            "{} bytes, more than the {MAX_GLTF_BYTES} accepted",
-            meta.len()
-        ));
-    }
-    std::fs::read(path).map_err(|e| format!("cannot read: {e}"))
+    read_limited(path, MAX_GLTF_BYTES).map_err(|e| format!("cannot read: {e}"))
 }
 
 fn to_f64(m: [[f32; 4]; 4]) -> Mat4 {

@@ -8,6 +8,8 @@
 //! triangles before the first `usemtl`.
 
 use crate::error::Error;
+use crate::input::read_limited;
+use crate::limits::MAX_MATERIALS;
 use crate::scene::OBJ_ALBEDO;
 use crate::spec::{ObjectSource, SceneSpec};
 use raykernel::render::scenes::{ObjectData, ShapeRange};
@@ -172,22 +174,11 @@ pub fn parse_mtl(bytes: &[u8], path: &Path) -> Result<Vec<MtlMaterial>, Error> {
 /// # Errors
 /// An unreadable or oversized file, or as [`parse_mtl`].
 pub fn load_mtl(path: &Path) -> Result<Vec<MtlMaterial>, Error> {
-    let fail = |msg: String| Error::Scene {
+    let bytes = read_limited(path, MAX_MTL_BYTES).map_err(|e| Error::Scene {
         file: path.display().to_string(),
         field: String::new(),
-        msg,
-    };
-    let meta = std::fs::metadata(path).map_err(|e| fail(format!("cannot read MTL file: {e}")))?;
-    if !meta.is_file() {
-        return Err(fail("not a regular file".into()));
-    }
-    if meta.len() > MAX_MTL_BYTES {
-        return Err(fail(format!(
-            "MTL file of {} bytes, more than the {MAX_MTL_BYTES} accepted",
-            meta.len()
-        )));
-    }
-    let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read MTL file: {e}")))?;
+        msg: format!("cannot read MTL file: {e}"),
+    })?;
     parse_mtl(&bytes, path)
 }
 
@@ -262,6 +253,13 @@ pub fn resolve(
                 })?
                 .to_kernel()
         };
+        if out.materials.len() >= MAX_MATERIALS {
+            return Err(Error::Scene {
+                file: format!("{}:{line}", obj_path.display()),
+                field: String::new(),
+                msg: format!("more than {MAX_MATERIALS} materials in use"),
+            });
+        }
         let i = u32::try_from(out.materials.len()).unwrap_or(u32::MAX);
         out.materials.push(material);
         out.names.push(name.to_string());
@@ -292,26 +290,23 @@ pub fn resolve(
 }
 
 /// Gives a mesh scene (one triangle object over all of `spec.triangles`, as
-/// [`crate::scene::obj_scene`] makes) one object per material: triangles are regrouped by
-/// material (stably, so each object keeps the file order) and the mesh's vertex lines follow.
+/// [`crate::scene::lit_mesh_scene`] makes) one object per material: triangles are regrouped by
+/// material (stably, so each object keeps the file order). With one material the object keeps
+/// its source (a dump names the mesh file); with several, each object holds part of the mesh,
+/// so its source becomes [`ObjectSource::Inline`] (a dump writes its triangles).
 pub fn split_by_material(spec: &mut SceneSpec, m: &MeshMaterials) {
     let n = spec.triangles.len().min(m.of_triangle.len());
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by_key(|&t| m.of_triangle[t]);
     spec.triangles = order.iter().map(|&t| spec.triangles[t]).collect();
-    let source = match spec.object_sources.first() {
-        Some(ObjectSource::Mesh { path, vertex_lines }) => ObjectSource::Mesh {
-            path: path.clone(),
-            vertex_lines: order
-                .iter()
-                .filter_map(|&t| vertex_lines.get(t).copied())
-                .collect(),
-        },
-        _ => ObjectSource::Inline,
-    };
+    // Only kept when one material covers the mesh: the order is then the file's.
+    let source = spec
+        .object_sources
+        .first()
+        .cloned()
+        .unwrap_or(ObjectSource::Inline);
     let motion = spec.objects.first().map_or([0.0; 3], |o| o.motion);
     spec.objects.clear();
-    spec.object_sources.clear();
     let mut first = 0usize;
     while first < n {
         let material = m.of_triangle[order[first]];
@@ -327,17 +322,13 @@ pub fn split_by_material(spec: &mut SceneSpec, m: &MeshMaterials) {
             material,
             motion,
         });
-        spec.object_sources.push(match &source {
-            ObjectSource::Mesh { path, vertex_lines } => ObjectSource::Mesh {
-                path: path.clone(),
-                vertex_lines: vertex_lines
-                    .get(first..first + count)
-                    .map_or_else(Vec::new, <[_]>::to_vec),
-            },
-            ObjectSource::Inline => ObjectSource::Inline,
-        });
         first += count;
     }
+    spec.object_sources = if spec.objects.len() == 1 {
+        vec![source]
+    } else {
+        vec![ObjectSource::Inline; spec.objects.len()]
+    };
     spec.materials.clone_from(&m.materials);
     spec.material_names.clone_from(&m.names);
 }

@@ -15,16 +15,20 @@
 mod build;
 mod node;
 mod optimize;
+mod parts;
+mod refit;
 mod select;
 mod traverse;
 mod validate;
 
 pub use node::Node;
+pub(crate) use refit::{check_prims, leaf_bounds};
+pub use refit::{RefitError, TreeShape};
 pub(crate) use traverse::{test_leaf, LeafPrims};
 pub(crate) use validate::check_permutation;
 pub use validate::{InvalidTree, TreeStats};
 
-use crate::error::BuildError;
+use crate::accel::BuildError;
 use crate::geom::Primitive;
 use crate::scalar::Scalar;
 use core::marker::PhantomData;
@@ -110,13 +114,18 @@ pub struct BuildOptions {
     pub reinsertion: bool,
 }
 
+impl BuildOptions {
+    /// The defaults: SAH, [`DEFAULT_LEAF_SIZE`], reinsertion on.
+    pub const DEFAULT: Self = Self {
+        builder: BuilderKind::Sah,
+        max_leaf_size: DEFAULT_LEAF_SIZE,
+        reinsertion: true,
+    };
+}
+
 impl Default for BuildOptions {
     fn default() -> Self {
-        Self {
-            builder: BuilderKind::Sah,
-            max_leaf_size: DEFAULT_LEAF_SIZE,
-            reinsertion: true,
-        }
+        Self::DEFAULT
     }
 }
 
@@ -187,7 +196,7 @@ impl<'a, S: Scalar, P: Primitive<S>> Bvh<'a, S, P> {
         let Some(ids) = prim_ids.get_mut(..prims.len()) else {
             // Unreachable: `build` checked the size.
             return Err(BuildError::ArenaTooSmall {
-                arena: crate::error::Arena::PrimIds,
+                arena: crate::accel::Arena::PrimIds,
                 needed: prims.len(),
                 available,
             });

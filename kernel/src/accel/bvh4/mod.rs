@@ -18,13 +18,15 @@
 
 mod collapse;
 mod node;
+mod parts;
+mod refit;
 mod traverse;
 mod validate;
 
 pub use node::Node4;
 
 use crate::accel::bvh::Bvh;
-use crate::error::BuildError;
+use crate::accel::BuildError;
 use crate::geom::Primitive;
 use crate::scalar::Scalar;
 use core::marker::PhantomData;

@@ -1,0 +1,134 @@
+//! `host bake` and `host trace-baked`: on a generated mesh (and on `../shared`'s suzanne when
+//! present), in both modes and both trees, tracing the baked file gives hit files
+//! byte-identical to `host trace` building the same tree in process; a corrupted file is
+//! refused with the loader's error.
+
+mod common;
+
+use common::{random_rays, temp_dir, Rng};
+use host::bake::{run_bake, run_trace_baked, BakeAccel, BakeArgs, TraceBakedArgs};
+use host::cli::{run_trace, TraceArgs};
+use host::mesh::unit_icosphere;
+use host::rayfile::write_rays;
+use host::trace::{AccelKind, Builder, Mode};
+use raykernel::bvh::DEFAULT_LEAF_SIZE;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// An icosphere OBJ (level 3, 1280 triangles, radius 1.2, jittered vertices) in `dir`.
+fn generated_obj(dir: &Path) -> PathBuf {
+    let (verts, faces) = unit_icosphere(3);
+    let mut rng = Rng::new(0xBA4E);
+    let mut text = String::new();
+    for v in &verts {
+        let r = 1.2 + 0.05 * rng.range(-1.0, 1.0);
+        writeln!(text, "v {} {} {}", v[0] * r, v[1] * r, v[2] * r).unwrap();
+    }
+    for f in &faces {
+        writeln!(text, "f {} {} {}", f[0] + 1, f[1] + 1, f[2] + 1).unwrap();
+    }
+    let path = dir.join("ico.obj");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn check_scene(obj: &Path, rays: &Path, dir: &Path) {
+    for mode in [Mode::F32, Mode::Fixed] {
+        for (accel, kind) in [
+            (BakeAccel::Bvh, AccelKind::Bvh),
+            (BakeAccel::Bvh4, AccelKind::Bvh4),
+        ] {
+            let case = format!("{} {mode:?} {accel:?}", obj.display());
+            let baked = dir.join("mesh.baked");
+            let report = run_bake(&BakeArgs {
+                scene: obj.to_path_buf(),
+                out: baked.clone(),
+                accel,
+                mode,
+                builder: Builder::Sah,
+                leaf: DEFAULT_LEAF_SIZE,
+                leaf_order: false,
+            })
+            .unwrap_or_else(|e| panic!("{case}: bake: {e}"));
+            assert_eq!(
+                report.bytes as u64,
+                std::fs::metadata(&baked).unwrap().len()
+            );
+            let built_hits = dir.join("built.hits");
+            let built = run_trace(&TraceArgs {
+                scene: obj.to_path_buf(),
+                rays: rays.to_path_buf(),
+                out: built_hits.clone(),
+                accel: kind,
+                builder: Builder::Sah,
+                mode,
+                leaf: DEFAULT_LEAF_SIZE,
+                no_reinsertion: false,
+                stride: 1,
+                runs: 1,
+                leaf_order: false,
+            })
+            .unwrap_or_else(|e| panic!("{case}: trace: {e}"));
+            let baked_hits = dir.join("baked.hits");
+            let loaded = run_trace_baked(&TraceBakedArgs {
+                baked: baked.clone(),
+                rays: rays.to_path_buf(),
+                out: baked_hits.clone(),
+            })
+            .unwrap_or_else(|e| panic!("{case}: trace-baked: {e}"));
+            assert!(built.hits > 0, "{case}: no hits");
+            assert_eq!(loaded.hits, built.hits, "{case}");
+            assert_eq!(loaded.grid_hash, report.grid_hash, "{case}: grid hash");
+            let (a, b) = (
+                std::fs::read(&built_hits).unwrap(),
+                std::fs::read(&baked_hits).unwrap(),
+            );
+            assert!(a == b, "{case}: baked hits differ from the built tree's");
+            // One flipped byte: refused (checksum), nothing written.
+            let mut bytes = std::fs::read(&baked).unwrap();
+            let mid = bytes.len() / 2;
+            bytes[mid] ^= 4;
+            std::fs::write(&baked, &bytes).unwrap();
+            let err = run_trace_baked(&TraceBakedArgs {
+                baked,
+                rays: rays.to_path_buf(),
+                out: dir.join("never.hits"),
+            })
+            .unwrap_err();
+            assert!(err.to_string().contains("checksum"), "{case}: {err}");
+        }
+    }
+}
+
+#[test]
+fn baked_files_trace_like_the_built_trees_on_a_generated_mesh() {
+    let dir = temp_dir("bake-generated");
+    let obj = generated_obj(&dir);
+    let rays = dir.join("rays.bin");
+    write_rays(
+        &rays,
+        &random_rays(&mut Rng::new(5), [-1.3; 3], [1.3; 3], 4000),
+    )
+    .unwrap();
+    check_scene(&obj, &rays, &dir);
+}
+
+#[test]
+fn baked_files_trace_like_the_built_trees_on_suzanne() {
+    let obj = PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../shared/scenes/suzanne.obj"
+    ));
+    if !obj.exists() {
+        println!("skipped: ../shared/scenes/suzanne.obj not found");
+        return;
+    }
+    let dir = temp_dir("bake-suzanne");
+    let rays = dir.join("rays.bin");
+    write_rays(
+        &rays,
+        &random_rays(&mut Rng::new(6), [-5.0, -3.6, -3.2], [5.0, 3.6, 3.1], 4000),
+    )
+    .unwrap();
+    check_scene(&obj, &rays, &dir);
+}

@@ -1,0 +1,73 @@
+//! Baked trees: a BVH or 4-wide BVH built on the host, stored with its triangles as bytes
+//! (`docs/BAKED_FORMAT.md`), and loaded on the device in place, without building.
+//!
+//! [`bake_bvh`] / [`bake_bvh4`] write a built tree; [`load_bvh`] / [`load_bvh4`] (or
+//! [`Baked::load`] for either kind) check untrusted bytes completely and return the same
+//! [`Bvh`] / [`Bvh4`] a build returns, borrowing the bytes: the same traversal, the same hits,
+//! bit for bit, no RAM for the structure. The bytes must be aligned to the node alignment
+//! ([`BakedKind::align`]: 32 for the binary tree, 128 for the 4-wide one; [`MAX_ALIGN`] fits
+//! both), e.g. by `#[repr(align(128))]` around an `include_bytes!` array.
+
+mod error;
+mod format;
+mod load;
+mod plain;
+mod scalar;
+mod write;
+
+pub use error::BakeError;
+pub use format::{
+    checksum, read_header, BakedKind, BakedMode, Header, FLAG_LEAF_ORDER, HEADER_LEN, MAGIC,
+    MAX_ALIGN, TRIANGLE_LEN, VERSION,
+};
+pub use load::{load_bvh, load_bvh4};
+pub use scalar::BakedScalar;
+pub use write::{bake_bvh, bake_bvh4, baked_len};
+
+use crate::accel::bvh::Bvh;
+use crate::accel::bvh4::Bvh4;
+use crate::accel::{Accel, Counters, Nearest};
+use crate::geom::{Ray, Triangle};
+
+/// A loaded baked tree of either kind.
+#[derive(Clone, Copy, Debug)]
+pub enum Baked<'a, S: BakedScalar> {
+    /// A binary BVH.
+    Bvh(Bvh<'a, S, Triangle<S>>),
+    /// A 4-wide BVH.
+    Bvh4(Bvh4<'a, S, Triangle<S>>),
+}
+
+impl<'a, S: BakedScalar> Baked<'a, S> {
+    /// Loads whichever kind `bytes` holds ([`load_bvh`], [`load_bvh4`]).
+    ///
+    /// # Errors
+    /// As the loaders; [`BakeError::WrongStructure`] for a file of the other mode.
+    pub fn load(bytes: &'a [u8]) -> Result<Self, BakeError> {
+        match read_header(bytes)?.kind {
+            BakedKind::Bvh => load_bvh(bytes).map(Self::Bvh),
+            BakedKind::Bvh4 => load_bvh4(bytes).map(Self::Bvh4),
+        }
+    }
+}
+
+impl<S: BakedScalar> Accel<S> for Baked<'_, S> {
+    fn nearest_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Nearest<S>> {
+        match self {
+            Self::Bvh(t) => t.nearest_counted(ray, stats),
+            Self::Bvh4(t) => t.nearest_counted(ray, stats),
+        }
+    }
+    fn occluded_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> bool {
+        match self {
+            Self::Bvh(t) => t.occluded_counted(ray, stats),
+            Self::Bvh4(t) => t.occluded_counted(ray, stats),
+        }
+    }
+    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
+        match self {
+            Self::Bvh(t) => t.barycentrics(ray, found),
+            Self::Bvh4(t) => t.barycentrics(ray, found),
+        }
+    }
+}

@@ -1,0 +1,27 @@
+//! A tree view over nodes that already exist (baked bytes, a refitted arena).
+
+use super::{Bvh, Node};
+use crate::geom::Primitive;
+use crate::scalar::Scalar;
+use core::marker::PhantomData;
+
+impl<'a, S: Scalar, P: Primitive<S>> Bvh<'a, S, P> {
+    /// The tree `nodes` (in use, root first), `prim_ids`, `prims` describe, unchecked: callers
+    /// validate before querying (traversal stays memory-safe either way).
+    pub(crate) fn from_parts(
+        nodes: &'a [Node<S>],
+        prim_ids: &'a [u32],
+        prims: &'a [P],
+        depth: u32,
+        leaf_order: bool,
+    ) -> Self {
+        Self {
+            nodes,
+            prim_ids,
+            prims,
+            depth,
+            leaf_order,
+            _scalar: PhantomData,
+        }
+    }
+}

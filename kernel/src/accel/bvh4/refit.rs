@@ -1,0 +1,78 @@
+//! Refit of the 4-wide tree: every slot box recomputed bottom-up after the primitives moved
+//! (see the binary tree's refit for the rule).
+
+use super::{Bvh4, Node4};
+use crate::accel::bvh::{check_prims, leaf_bounds};
+use crate::accel::bvh::{RefitError, TreeShape};
+use crate::geom::{Aabb, Primitive};
+use crate::scalar::Scalar;
+
+impl<'a, S: Scalar, P: Primitive<S>> Bvh4<'a, S, P> {
+    /// Node count, depth and primitive order: what [`Bvh4::refit`] needs to know.
+    #[must_use]
+    pub fn shape(&self) -> TreeShape {
+        TreeShape {
+            node_count: self.nodes.len(),
+            depth: self.depth,
+            leaf_order: self.leaf_order,
+        }
+    }
+
+    /// Refits the wide tree in `nodes` (over `prim_ids`, as left by a collapse of `shape`) to
+    /// `prims`, the same primitives with moved vertices, and returns it. `O(n)`, no allocation,
+    /// no recursion.
+    ///
+    /// # Errors
+    /// [`RefitError::BadPrimitive`] (nothing changed), [`RefitError::ShapeMismatch`].
+    pub fn refit(
+        prims: &'a [P],
+        nodes: &'a mut [Node4<S>],
+        prim_ids: &'a [u32],
+        shape: TreeShape,
+    ) -> Result<Self, RefitError> {
+        check_prims(prims)?;
+        let count = shape.node_count;
+        let mismatch = |node| RefitError::ShapeMismatch { node };
+        if prim_ids.len() != prims.len() || (count == 0) != prims.is_empty() {
+            return Err(mismatch(0));
+        }
+        let nodes = nodes.get_mut(..count).ok_or(mismatch(count))?;
+        // Wide nodes are breadth-first, children after parents: refit in reverse.
+        for i in (0..count).rev() {
+            let node = nodes.get(i).copied().ok_or(mismatch(i))?;
+            let mut out = node;
+            for slot in 0..node.child_count() {
+                let Some((child, k)) = node.slot(slot) else {
+                    continue;
+                };
+                let b = if k == 0 {
+                    let c = child as usize;
+                    let kid = nodes.get(c).filter(|_| c > i).ok_or(mismatch(i))?;
+                    node_bounds(kid).ok_or(mismatch(c))?
+                } else {
+                    let leaf = (prim_ids, prims, shape.leaf_order);
+                    leaf_bounds(leaf, (child as usize, k as usize)).ok_or(mismatch(i))?
+                };
+                out.set(slot, &b, child, k);
+            }
+            if let Some(n) = nodes.get_mut(i) {
+                *n = out;
+            }
+        }
+        let nodes: &'a [Node4<S>] = nodes;
+        Ok(Self::from_parts(
+            nodes,
+            prim_ids,
+            prims,
+            shape.depth,
+            shape.leaf_order,
+        ))
+    }
+}
+
+/// The union of a node's used slot boxes (`None` for a node without any).
+fn node_bounds<S: Scalar>(node: &Node4<S>) -> Option<Aabb<S>> {
+    (0..node.child_count())
+        .filter_map(|s| node.bounds(s))
+        .reduce(|a, b| a.union(&b))
+}
