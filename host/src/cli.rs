@@ -252,10 +252,10 @@ pub struct RenderArgs {
     pub tile: u32,
 }
 
-/// `host check [SCENE...]`.
+/// `raykernel check [SCENE...]`.
 #[derive(Clone, Debug, Args)]
 pub struct CheckArgs {
-    /// Scenes as for `host render` [default: every built-in scene].
+    /// Scenes as for `raykernel render` [default: every built-in scene].
     pub scenes: Vec<String>,
     /// Only this mode [default: both].
     #[arg(long, value_enum)]
@@ -265,7 +265,7 @@ pub struct CheckArgs {
     pub settings: SettingsArgs,
 }
 
-/// The JSON report of `host render`.
+/// The JSON report of `raykernel render`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RenderReport {
     /// Scene name.
@@ -364,7 +364,7 @@ impl RenderReport {
     }
 }
 
-/// The JSON report of `host check`.
+/// The JSON report of `raykernel check`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct CheckReport {
     /// One entry per scene and mode.
@@ -375,7 +375,7 @@ pub struct CheckReport {
     pub differences: usize,
 }
 
-/// `host trace SCENE.obj RAYS --out HITS [options]`.
+/// `raykernel trace SCENE.obj RAYS --out HITS [options]`.
 #[derive(Clone, Debug, Args)]
 pub struct TraceArgs {
     /// The scene (Wavefront OBJ).
@@ -414,7 +414,7 @@ pub struct TraceArgs {
     pub leaf_order: bool,
 }
 
-/// `host compare-hits REF OTHER [--rel R] [--scene OBJ --rays RAYS]`.
+/// `raykernel compare-hits REF OTHER [--rel R] [--scene OBJ --rays RAYS]`.
 #[derive(Clone, Debug, Args)]
 pub struct CompareArgs {
     /// The reference hit file.
@@ -432,8 +432,8 @@ pub struct CompareArgs {
     pub rays: Option<PathBuf>,
 }
 
-/// The JSON report of `host compare-hits`: the agreement figures, plus the classification of the
-/// differing rays when `--scene` and `--rays` are given.
+/// The JSON report of `raykernel compare-hits`: the agreement figures, plus the classification
+/// of the differing rays when `--scene` and `--rays` are given.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct CompareReport {
     /// Agreement figures.
@@ -444,7 +444,7 @@ pub struct CompareReport {
     pub classification: Option<Classification>,
 }
 
-/// The JSON report of `host trace`.
+/// The JSON report of `raykernel trace`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TraceReport {
     /// Scene path.
@@ -868,7 +868,7 @@ pub fn run_check_with(args: &CheckArgs, console: &Console) -> Result<CheckReport
     })
 }
 
-/// `host trace`: load the scene and rays, trace, write the hits.
+/// `raykernel trace`: load the scene and rays, trace, write the hits.
 ///
 /// # Errors
 /// Bad or unreadable inputs, an unwritable output, or a build the kernel refuses.
@@ -995,7 +995,7 @@ impl TraceReport {
     }
 }
 
-/// `host compare-hits`: agreement of OTHER with REF.
+/// `raykernel compare-hits`: agreement of OTHER with REF.
 ///
 /// # Errors
 /// Unreadable or malformed hit files, or files of different lengths; with `--scene` and

@@ -60,7 +60,7 @@ pub enum Error {
         /// What is wrong, or what was expected.
         msg: String,
     },
-    /// `host check`: two renders that must be byte-identical differ.
+    /// `raykernel check`: two renders that must be byte-identical differ.
     Mismatch(String),
     /// An output could not be encoded or written.
     Output {
@@ -251,7 +251,7 @@ mod tests {
         assert_eq!(shorten_long_words("a bb  ccc", 3), "a bb  ccc");
         assert_eq!(
             shorten_long_words("key `abcdefghijkl`, x", 8),
-            "key `abc[… 7 characters …]l`, x"
+            "key `abc[… 9 characters …]`, x"
         );
     }
 }

@@ -1,6 +1,7 @@
-//! Scenes for `host render` and `host check`: what the SCENE argument names (a built-in scene,
-//! a scene file, or an OBJ mesh), and the lights, material and camera an OBJ gets: the camera
-//! from its `NAME.camera` file (format of `shared/bench/WORKLOAD.md`) or framed by its box.
+//! Scenes for `raykernel render` and `raykernel check`: what the SCENE argument names (a
+//! built-in scene, a scene file, or an OBJ mesh), and the lights, material and camera an OBJ
+//! gets: the camera from its `NAME.camera` file (format of `shared/bench/WORKLOAD.md`) or
+//! framed by its box.
 
 use crate::error::Error;
 use crate::input::read_text_limited;

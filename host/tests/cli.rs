@@ -282,7 +282,10 @@ fn compare_hits_classifies_fixed_vs_f32_differences() {
     let count = |k: &str| v[k].as_u64().unwrap_or_else(|| panic!("{k} in {v}"));
     assert_eq!(
         count("differing"),
-        count("explained_by_quantization") + count("explained_by_depth") + count("unexplained"),
+        count("explained_by_quantization")
+            + count("explained_by_depth")
+            + count("explained_by_origin")
+            + count("unexplained"),
         "{v}"
     );
     assert_eq!(count("unexplained"), 0, "{v}");

@@ -9,6 +9,12 @@
 //! - `cargo xtask size`: the footprint of the size probes on the three thumb targets (`.text`,
 //!   `.rodata`, stack measured on target; see `size.rs`), arena bytes per triangle; the last
 //!   stdout line is one JSON object.
+//! - `cargo xtask determinism`: the golden hashes on every architecture (x86_64, aarch64 under
+//!   qemu-aarch64, wasm32 under Node.js's WASI, RISC-V and the three Cortex-M cores under QEMU)
+//!   and hit files compared with x86_64's; writes the table of docs/PLATFORMS.md
+//!   (`determinism.rs`).
+//! - `cargo xtask speed`: instructions per ray and per pixel on the emulated cores; writes the
+//!   table of docs/PLATFORMS.md (`speed.rs`).
 //! - `cargo xtask bless`: rewrites the goldens: the hash file `tests/golden/kernel_hashes.txt`
 //!   (the kernel's golden test), then the snapshot PNGs `tests/golden/images/` (the host's
 //!   snapshot test, which also checks its renders against the new hashes).
@@ -19,7 +25,10 @@
 #[path = "../../tests/golden/cases.rs"]
 #[allow(dead_code, clippy::all)]
 mod cases;
+mod determinism;
+mod platforms;
 mod size;
+mod speed;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
@@ -66,9 +75,13 @@ fn main() -> ExitCode {
             r.1 == 0
         }
         Some("size") => size::size(),
+        Some("determinism") => determinism::determinism(),
+        Some("speed") => speed::speed(),
         Some("bless") => bless(),
         _ => {
-            eprintln!("usage: cargo xtask <qemu | panic-check | size | bless>");
+            eprintln!(
+                "usage: cargo xtask <qemu | panic-check | size | determinism | speed | bless>"
+            );
             false
         }
     };
