@@ -210,6 +210,9 @@ pub struct RenderArgs {
     /// Also write the linear image (mean radiance per pixel, unclipped) as a PFM file.
     #[arg(long, value_name = "FILE.pfm")]
     pub linear: Option<PathBuf>,
+    /// Also write the linear image as an OpenEXR file (32-bit float RGB, the PFM's values).
+    #[arg(long, value_name = "FILE.exr")]
+    pub exr: Option<PathBuf>,
     /// Write the scene, with the settings and camera this command would render it with, as a
     /// scene file (meshes read from OBJ files are named, relative to it, not inlined).
     #[arg(long, value_name = "FILE.json")]
@@ -625,6 +628,7 @@ pub struct RenderJob {
     tile: u32,
     out: Option<Reserved>,
     linear: Option<Reserved>,
+    exr: Option<Reserved>,
     /// The report so far: everything but the render's figures.
     pub report: RenderReport,
 }
@@ -648,6 +652,10 @@ impl RenderJob {
             Some(p) if rendering => Some(Reserved::new(p, Format::Pfm, "--linear")?),
             _ => None,
         };
+        let exr = match &args.exr {
+            Some(p) if rendering => Some(Reserved::new(p, Format::Exr, "--exr")?),
+            _ => None,
+        };
         let dump = match &args.dump_scene {
             Some(p) => Some(Reserved::new(p, Format::SceneFile, "--dump-scene")?),
             None => None,
@@ -656,7 +664,7 @@ impl RenderJob {
         spec.settings = args.settings.apply(render_base_settings(&spec));
         spec.camera = args.camera.apply(spec.camera);
         let mode = args.mode;
-        let the_plan = check_render_request(&spec, mode, linear.is_some())?;
+        let the_plan = check_render_request(&spec, mode, linear.is_some() || exr.is_some())?;
         let settings = spec.settings;
         let accel = args.accel.with_build_options(BuildOptions {
             builder: args.builder.into(),
@@ -697,6 +705,7 @@ impl RenderJob {
             tile: args.tile,
             out,
             linear,
+            exr,
             report,
         })
     }
@@ -716,6 +725,7 @@ impl RenderJob {
             tile,
             out,
             linear,
+            exr,
             mut report,
         } = self;
         let Some(out) = out else {
@@ -738,6 +748,13 @@ impl RenderJob {
         if let Some(file) = linear {
             report.linear = Some(file.path().display().to_string());
             file.write(&encode_pfm(&r.frame))?;
+        }
+        if let Some(file) = exr {
+            let bytes = crate::exr::encode_exr(&r.frame).map_err(|msg| Error::Output {
+                path: file.path().to_path_buf(),
+                msg,
+            })?;
+            file.write(&bytes)?;
         }
         let rays = r.stats.rays();
         report.figures = Some(RenderFigures {

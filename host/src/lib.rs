@@ -3,7 +3,8 @@
 //! Everything the binary does lives here so it can be tested without spawning it:
 //! - [`input`]: reading input files (regular files only, size-capped),
 //! - [`limits`]: bounds on every resource a file or flag can request, and the memory check,
-//! - [`obj`]: OBJ reader with `file:line` errors,
+//! - [`obj`]: OBJ reader with `file:line` errors, [`mtl`]: its MTL materials,
+//! - [`gltf`]: glTF 2.0 scenes,
 //! - [`rayfile`]: ray and hit file records,
 //! - [`trace`]: build an accelerator and trace rays, generic over the kernel's scalar modes,
 //! - [`compare`]: agreement between two hit files,
@@ -13,6 +14,7 @@
 //! - [`scenefile`]: the JSON scene format (load, dump),
 //! - [`scene`]: what a SCENE argument names (built-in, scene file, OBJ with camera and lights),
 //! - [`render`]: parallel tiles over the kernel's distribution ray tracer, PNG and PFM out,
+//!   [`exr`]: OpenEXR out,
 //! - [`check`]: every way of rendering gives the same bytes,
 //! - [`snapshot`]: exact comparison with golden images and hashes,
 //! - [`cli`]: the command line (clap) and the commands behind it,
@@ -28,9 +30,12 @@ pub mod cli;
 pub mod compare;
 pub mod console;
 pub mod error;
+pub mod exr;
+pub mod gltf;
 pub mod input;
 pub mod limits;
 pub mod mesh;
+pub mod mtl;
 pub mod obj;
 pub mod output;
 pub mod rayfile;

@@ -2,8 +2,9 @@
 //!
 //! Accepted: `v x y z [w]` (also `v x y z r g b`, the common vertex-colour extension), and `f`
 //! with entries `v`, `v/vt`, `v//vn` or `v/vt/vn`, 1-based or negative (relative) indices.
-//! Polygons are fan-triangulated: (v0,v1,v2), (v0,v2,v3), ... Every other statement (`vt`,
-//! `vn`, `o`, `g`, `s`, `usemtl`, `mtllib`, `l`, ...) is ignored, as is anything after `#`.
+//! Polygons are fan-triangulated: (v0,v1,v2), (v0,v2,v3), ... `mtllib` and `usemtl` are
+//! collected by [`parse_obj_with_materials`] ([`crate::mtl`] reads the libraries). Every other
+//! statement (`vt`, `vn`, `o`, `g`, `s`, `l`, ...) is ignored, as is anything after `#`.
 //!
 //! The triangle id used in hit files is the 0-based index of a triangle in this output order.
 //! A positive index may point at a vertex defined later in the file (checked once the whole file
@@ -15,6 +16,7 @@
 
 use crate::input::{read_limited, InputError};
 use crate::limits::{MAX_OBJ_FILE_BYTES, MAX_TRIANGLES};
+use crate::mtl::MaterialRefs;
 use raykernel::{PointError, Scalar, Triangle, F32_COORD_LIMIT, FIXED_COORD_LIMIT};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -246,15 +248,40 @@ pub fn load_obj(path: &Path) -> Result<Mesh, ObjError> {
     parse_obj(&bytes, path)
 }
 
+/// Reads and parses an OBJ file with its `mtllib` and `usemtl` statements.
+///
+/// # Errors
+/// As [`load_obj`].
+pub fn load_obj_with_materials(path: &Path) -> Result<(Mesh, MaterialRefs), ObjError> {
+    let bytes = read_limited(path, MAX_OBJ_FILE_BYTES).map_err(|e| ObjError {
+        path: path.to_path_buf(),
+        line: None,
+        kind: ObjErrorKind::Read(e),
+    })?;
+    parse_obj_with_materials(&bytes, path)
+}
+
 /// Parses OBJ text; `path_for_errors` only labels errors. Never panics.
 ///
 /// # Errors
 /// The first problem found, with its line.
 pub fn parse_obj(bytes: &[u8], path_for_errors: &Path) -> Result<Mesh, ObjError> {
+    parse_obj_with_materials(bytes, path_for_errors).map(|(mesh, _)| mesh)
+}
+
+/// [`parse_obj`], also returning the material statements (which triangles each `usemtl` names).
+///
+/// # Errors
+/// As [`parse_obj`].
+pub fn parse_obj_with_materials(
+    bytes: &[u8],
+    path_for_errors: &Path,
+) -> Result<(Mesh, MaterialRefs), ObjError> {
     let err = |line: usize, kind| ObjError::at(path_for_errors, line, kind);
     // A byte-order mark is not part of the first statement.
     let bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
     let mut mesh = Mesh::default();
+    let mut materials = MaterialRefs::default();
     let mut face: Vec<u32> = Vec::new();
     let mut line_no = 0usize;
     for raw_line in bytes.split(|&b| b == b'\n') {
@@ -309,6 +336,8 @@ pub fn parse_obj(bytes: &[u8], path_for_errors: &Path) -> Result<Mesh, ObjError>
                     mesh.triangle_lines.push(line_no);
                 }
             }
+            Some(b"mtllib") => materials.add_libraries(tokens, line_no),
+            Some(b"usemtl") => materials.start_group(tokens, line_no, mesh.triangles.len()),
             _ => {}
         }
     }
@@ -330,7 +359,7 @@ pub fn parse_obj(bytes: &[u8], path_for_errors: &Path) -> Result<Mesh, ObjError>
             ));
         }
     }
-    Ok(mesh)
+    Ok((mesh, materials))
 }
 
 /// A token for error messages: lossy UTF-8, at most 40 characters.

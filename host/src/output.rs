@@ -17,6 +17,8 @@ pub enum Format {
     Png,
     /// Linear PFM (`--linear`).
     Pfm,
+    /// Linear OpenEXR (`--exr`).
+    Exr,
     /// A scene file (`--dump-scene`).
     SceneFile,
 }
@@ -28,6 +30,7 @@ impl Format {
         match self {
             Self::Png => "png",
             Self::Pfm => "pfm",
+            Self::Exr => "exr",
             Self::SceneFile => "json",
         }
     }
@@ -36,6 +39,7 @@ impl Format {
         match self {
             Self::Png => "a PNG image (8-bit sRGB); PNG is the only image format of --out",
             Self::Pfm => "a PFM image (linear radiance)",
+            Self::Exr => "an OpenEXR image (linear radiance)",
             Self::SceneFile => "a scene file (JSON)",
         }
     }

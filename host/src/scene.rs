@@ -6,7 +6,7 @@
 use crate::error::Error;
 use crate::input::read_text_limited;
 use crate::limits::MAX_CAMERA_FILE_BYTES;
-use crate::obj::load_obj;
+use crate::obj::load_obj_with_materials;
 use crate::scenefile::{load_scene_file, DEFAULT_SETTINGS};
 use crate::spec::{eye_to_look_at, ObjectSource, SceneOrigin, SceneSpec};
 use raykernel::render::scenes::{self, ObjectData, ShapeRange};
@@ -17,7 +17,7 @@ use std::path::Path;
 pub const DEFAULT_SCENE: &str = "cornell";
 
 /// Loads what a SCENE argument names: a built-in scene (`cornell`, `spheres`, `motion`), a
-/// scene file (`.json`) or an OBJ mesh (`.obj`).
+/// scene file (`.json`), an OBJ mesh (`.obj`) or a glTF 2.0 scene (`.gltf`, `.glb`).
 ///
 /// # Errors
 /// An unknown name, or the loader's error for the file.
@@ -32,11 +32,12 @@ pub fn resolve_scene(arg: &str) -> Result<SceneSpec, Error> {
     match ext.as_deref() {
         Some("json") => load_scene_file(path),
         Some("obj") => obj_scene(path),
+        Some("gltf" | "glb") => crate::gltf::gltf_scene(path),
         _ => {
             let names: Vec<&str> = scenes::ALL.iter().map(|s| s.name).collect();
             Err(Error::Usage(format!(
-                "unknown scene `{arg}`: expected a built-in scene ({}), a scene file (.json) \
-                 or an OBJ mesh (.obj)",
+                "unknown scene `{arg}`: expected a built-in scene ({}), a scene file (.json), \
+                 an OBJ mesh (.obj) or a glTF scene (.gltf, .glb)",
                 names.join(", ")
             )))
         }
@@ -211,16 +212,14 @@ pub const OBJ_LIGHT_RADIANCE: [f32; 3] = [10.0, 10.0, 9.5];
 /// Background radiance of an OBJ scene.
 pub const OBJ_BACKGROUND: [f32; 3] = [0.03, 0.035, 0.045];
 
-/// An OBJ mesh as a scene: one white diffuse material ([`OBJ_ALBEDO`]); the camera from
-/// `NAME.camera` beside it, else framed by the mesh's box (for the default 512×512 image); a
-/// square area light facing down, half the box's diagonal wide and half a diagonal above the
-/// box's top (radiance [`OBJ_LIGHT_RADIANCE`]); a dim point light at the eye for fill (it gives
-/// `0.35` irradiance at the box centre); +y is up. Settings are [`DEFAULT_SETTINGS`].
+/// An OBJ mesh as a scene: one white diffuse material ([`OBJ_ALBEDO`]), or with `mtllib` and
+/// `usemtl` one object per material ([`crate::mtl`]); the camera from `NAME.camera` beside it,
+/// else framed by the mesh's box; lights as [`lit_mesh_scene`] places them.
 ///
 /// # Errors
-/// An unreadable or bad OBJ, or a bad `.camera` file.
+/// An unreadable or bad OBJ or MTL file, or a bad `.camera` file.
 pub fn obj_scene(path: &Path) -> Result<SceneSpec, Error> {
-    let mesh = load_obj(path)?;
+    let (mesh, material_refs) = load_obj_with_materials(path)?;
     let triangles: Vec<[[f32; 3]; 3]> = (0..mesh.triangle_count())
         .map(|i| mesh.triangle_f32(i))
         .collect();
@@ -229,7 +228,6 @@ pub fn obj_scene(path: &Path) -> Result<SceneSpec, Error> {
         .iter()
         .map(|t| t.map(|c| mesh.position_lines[c as usize]))
         .collect();
-    let (lo, hi) = bounds(&triangles);
     let camera_path = path.with_extension("camera");
     let camera = if camera_path.is_file() {
         let text =
@@ -238,10 +236,39 @@ pub fn obj_scene(path: &Path) -> Result<SceneSpec, Error> {
                 line: None,
                 msg: format!("cannot read: {e}"),
             })?;
-        PinholeCamera::parse(&text, &camera_path)?
+        Some(PinholeCamera::parse(&text, &camera_path)?)
     } else {
-        PinholeCamera::frame(lo, hi, DEFAULT_SETTINGS.width, DEFAULT_SETTINGS.height)
+        None
     };
+    let source = ObjectSource::Mesh {
+        path: path.to_path_buf(),
+        vertex_lines,
+        transform: None,
+    };
+    let mut spec = lit_mesh_scene(path, triangles, source, camera);
+    if let Some(m) = crate::mtl::resolve(path, &material_refs, mesh.triangle_count())? {
+        crate::mtl::split_by_material(&mut spec, &m);
+    }
+    Ok(spec)
+}
+
+/// A triangle mesh from `path` (an OBJ or glTF file) as one white diffuse object ([`OBJ_ALBEDO`])
+/// in a lit scene: the given camera, else one framing the mesh's box (for the default
+/// 512×512 image); a square area light facing down, half the box's diagonal wide and half a
+/// diagonal above the box's top (radiance [`OBJ_LIGHT_RADIANCE`]); a dim point light at the eye
+/// for fill (it gives `0.35` irradiance at the box centre); +y is up. Settings are
+/// [`DEFAULT_SETTINGS`].
+#[must_use]
+pub fn lit_mesh_scene(
+    path: &Path,
+    triangles: Vec<[[f32; 3]; 3]>,
+    source: ObjectSource,
+    camera: Option<PinholeCamera>,
+) -> SceneSpec {
+    let (lo, hi) = bounds(&triangles);
+    let camera = camera.unwrap_or_else(|| {
+        PinholeCamera::frame(lo, hi, DEFAULT_SETTINGS.width, DEFAULT_SETTINGS.height)
+    });
     let diag = norm(sub(hi, lo)).max(1e-3);
     let centre: [f64; 3] = std::array::from_fn(|k| (lo[k] + hi[k]) / 2.0);
     let side = 0.5 * diag;
@@ -257,7 +284,7 @@ pub fn obj_scene(path: &Path) -> Result<SceneSpec, Error> {
     let name = path
         .file_stem()
         .map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
-    Ok(SceneSpec {
+    SceneSpec {
         name,
         origin: SceneOrigin::Obj(path.to_path_buf()),
         triangles,
@@ -267,11 +294,7 @@ pub fn obj_scene(path: &Path) -> Result<SceneSpec, Error> {
             material: 0,
             motion: [0.0; 3],
         }],
-        object_sources: vec![ObjectSource::Mesh {
-            path: path.to_path_buf(),
-            vertex_lines,
-            transform: None,
-        }],
+        object_sources: vec![source],
         materials: vec![Material::Diffuse { albedo: OBJ_ALBEDO }],
         material_names: vec!["white".into()],
         lights: vec![
@@ -290,7 +313,7 @@ pub fn obj_scene(path: &Path) -> Result<SceneSpec, Error> {
         camera: camera.to_kernel(),
         background: OBJ_BACKGROUND,
         settings: DEFAULT_SETTINGS,
-    })
+    }
 }
 
 /// The box of a triangle list (the unit box for none).

@@ -38,6 +38,7 @@ fn small(scene: Option<PathBuf>, out: PathBuf, mode: Mode) -> RenderArgs {
         scene: scene.map(|p| p.display().to_string()),
         out: Some(out),
         linear: None,
+        exr: None,
         dump_scene: None,
         explain: false,
         settings: SettingsArgs {

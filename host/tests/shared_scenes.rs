@@ -1,6 +1,6 @@
-//! The shared benchmark scenes (`../shared/scenes`, beside the workspace), when present:
-//! every BVH builder, the grid and the kd-tree must give the same hits as brute force, byte for
-//! byte, in both modes.
+//! The shared benchmark scenes (`../shared/scenes`, beside the workspace): every BVH builder,
+//! the grid and the kd-tree must give the same hits as brute force, byte for byte, in both
+//! modes. Ignored by default ("needs ../shared"); `--ignored` runs them.
 
 mod common;
 
@@ -14,17 +14,21 @@ use raykernel::kdtree::KdOptions;
 use raykernel::AccelKind;
 use std::path::PathBuf;
 
-fn shared() -> Option<PathBuf> {
+/// `../shared`; these tests are `#[ignore]`d by default and fail here when it is missing, so
+/// `--ignored` never passes without the meshes.
+fn shared() -> PathBuf {
     let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared"));
-    dir.join("scenes/bunny.obj").exists().then_some(dir)
+    assert!(
+        dir.join("scenes/bunny.obj").exists(),
+        "../shared not found (the benchmark meshes beside the repository)"
+    );
+    dir
 }
 
 #[test]
+#[ignore = "needs ../shared"]
 fn bunny_bvh_matches_brute_force_for_every_builder_and_mode() {
-    let Some(shared) = shared() else {
-        println!("skipped: ../shared not found");
-        return;
-    };
+    let shared = shared();
     let scenes = shared.join("scenes");
     let obj = scenes.join("bunny.obj");
     let mesh = load_obj(&obj).unwrap();
@@ -107,11 +111,9 @@ fn inner_area(bvh: &raykernel::Bvh<'_, f32, raykernel::Triangle<f32>>) -> f64 {
 }
 
 #[test]
+#[ignore = "needs ../shared"]
 fn reinsertion_shrinks_the_kitchen_tree() {
-    let Some(shared) = shared() else {
-        println!("skipped: ../shared not found");
-        return;
-    };
+    let shared = shared();
     let obj = shared.join("scenes/kitchen.obj");
     let tris = load_obj(&obj)
         .unwrap()

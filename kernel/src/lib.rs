@@ -16,7 +16,7 @@
 //!
 //! ```
 //! use raykernel::{bvh::{nodes_needed, BuildOptions}, Accel, Bvh, Node, Ray, Triangle};
-//! use glam::Vec3;
+//! use raykernel::glam::Vec3;
 //!
 //! const N: usize = 2;
 //! let tris: [Triangle<f32>; N] = [

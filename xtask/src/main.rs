@@ -1,8 +1,9 @@
 //! Repository tasks, run from the repository root:
 //!
 //! - `cargo xtask qemu`: the on-target tests (`tests/qemu`, defmt-test under QEMU) on the
-//!   Cortex-M4F, M3 and M0, the README's embedded example on all three, and the panic-freedom
-//!   link check; prints a per-target summary and a final `N passed, M failed` line.
+//!   Cortex-M4F, M3 and M0, the embedded example of docs/EMBEDDED.md on all three, and the
+//!   panic-freedom link check; prints a per-target summary and a final `N passed, M failed`
+//!   line.
 //! - `cargo xtask panic-check`: only the panic-freedom link check (release, all three targets);
 //!   on failure, lists the kernel source lines that still reach a panic.
 //! - `cargo xtask size`: the footprint of the size probes on the three thumb targets (`.text`,
@@ -200,7 +201,7 @@ fn qemu() -> bool {
             if ok { "pass" } else { "FAIL" }
         ));
 
-        println!("\n=== README example: {core} ===");
+        println!("\n=== embedded example: {core} ===");
         let built = run(cargo(&[
             "build",
             "--release",
@@ -230,14 +231,14 @@ fn qemu() -> bool {
             if ran { "pass" } else { "FAIL" }
         ));
     }
-    println!("\n=== README embedded example matches tests/qemu/src/bin/readme_example.rs ===");
+    println!("\n=== docs/EMBEDDED.md example matches tests/qemu/src/bin/readme_example.rs ===");
     let same = readme_example_matches();
     println!(
         "{}",
         if same {
             "same code"
         } else {
-            "README and readme_example.rs differ"
+            "docs/EMBEDDED.md and readme_example.rs differ"
         }
     );
     if same {
@@ -246,7 +247,7 @@ fn qemu() -> bool {
         failed += 1;
     }
     summary.push(format!(
-        "{:<34} README example in sync {}",
+        "{:<34} embedded example in sync {}",
         "host",
         if same { "pass" } else { "FAIL" }
     ));
@@ -268,18 +269,18 @@ fn qemu() -> bool {
     failed == 0
 }
 
-/// The README's code block under `## Embedded use` equals the lines between the `README`
-/// markers of `readme_example.rs`.
+/// The code block of docs/EMBEDDED.md (under `# Embedded use`) equals the lines between the
+/// `README` markers of `readme_example.rs`.
 fn readme_example_matches() -> bool {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let (Ok(readme), Ok(code)) = (
-        std::fs::read_to_string(root.join("README.md")),
+        std::fs::read_to_string(root.join("docs/EMBEDDED.md")),
         std::fs::read_to_string(qemu_dir().join("src/bin/readme_example.rs")),
     ) else {
         return false;
     };
     let block = readme
-        .split_once("## Embedded use")
+        .split_once("# Embedded use")
         .and_then(|(_, rest)| rest.split_once("```rust,ignore\n"))
         .and_then(|(_, rest)| rest.split_once("```"))
         .map(|(b, _)| b.trim());
@@ -410,7 +411,7 @@ mod tests {
     fn readme_example_is_in_sync() {
         assert!(
             readme_example_matches(),
-            "README's `## Embedded use` block differs from tests/qemu/src/bin/readme_example.rs"
+            "docs/EMBEDDED.md's code block differs from tests/qemu/src/bin/readme_example.rs"
         );
     }
 

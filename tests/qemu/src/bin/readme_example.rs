@@ -1,4 +1,4 @@
-//! The README's embedded example: the lines between the `README` markers are the README's code
+//! The embedded example of docs/EMBEDDED.md: the lines between the `README` markers are its code
 //! block, word for word (`cargo xtask qemu` checks that, builds this for all three cores and
 //! runs it under QEMU: it exits 0 when the ray hits the nearer triangle at t = 5).
 #![no_std]
