@@ -9,7 +9,6 @@
 #define RAYKERNEL_GRID_HASH_H
 
 #include <stdint.h>
-#include <string.h>
 #include "raykernel.h"
 
 #define RK_GRID_N 32
@@ -41,10 +40,11 @@ static uint32_t rk_grid_hash(const RkAccel *accel, RkStatus *status) {
                 *status = s;
                 return 0;
             }
-            uint32_t t_bits = 0;
-            if (hit.prim != RK_NO_HIT) {
-                memcpy(&t_bits, &hit.t, 4);
-            }
+            union {
+                float f;
+                uint32_t u;
+            } t = {hit.t};
+            uint32_t t_bits = hit.prim != RK_NO_HIT ? t.u : 0u;
             h = rk_fnv1a(h, hit.prim, 4);
             h = rk_fnv1a(h, t_bits, 4);
             h = rk_fnv1a(h, any ? 1u : 0u, 1);

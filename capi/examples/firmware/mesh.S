@@ -10,3 +10,4 @@ baked_mesh_end:
     .global baked_mesh_len
 baked_mesh_len:
     .word baked_mesh_end - baked_mesh
+    .section .note.GNU-stack, "", %progbits
