@@ -1,19 +1,21 @@
 #!/usr/bin/env bash
 # Single-threaded trace benchmark on the shared scenes (WORKLOAD.md protocol: 3 full runs of
 # build + trace in one process, medians). Prints a Markdown table with the machine line.
+# `Mrays/s` is `host trace`'s per-ray figure (each ray constructed from its record in the timed
+# loop); `pre-built` traces rays constructed ahead; `setup ns` is that construction per ray.
 # usage: bench_trace.sh RAYS_DIR [extra trace flags...]
 set -euo pipefail
 rays=${1:?usage: bench_trace.sh RAYS_DIR [trace flags]}
 shift
 root=$(cd "$(dirname "$0")/../.." && pwd)
 scenes=${SCENES_DIR:-$root/../shared/scenes}
-host=$root/target/release/host
+host=$root/target/release/raykernel
 cargo build --quiet --release -p raykernel-host --manifest-path "$root/Cargo.toml"
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
 echo "machine: $cpu, $(nproc) cores; $(rustc --version); single thread; flags: ${*:-(defaults)}"
 echo
-echo "| scene | rays | mode | build ms | Mrays/s | Mrays/s incl. setup | nodes | bytes/tri | depth |"
-echo "|---|---|---|---:|---:|---:|---:|---:|---:|"
+echo "| scene | rays | mode | build ms | Mrays/s | pre-built Mrays/s | setup ns/ray | nodes | bytes/tri | depth |"
+echo "|---|---|---|---:|---:|---:|---:|---:|---:|---:|"
 out=$(mktemp)
 for scene in bunny sponza kitchen; do
     for kind in primary incoherent; do
@@ -22,7 +24,7 @@ for scene in bunny sponza kitchen; do
             python3 - "$scene" "$kind" "$mode" "$json" <<'PY'
 import json, sys
 scene, kind, mode, j = sys.argv[1], sys.argv[2], sys.argv[3], json.loads(sys.argv[4])
-print(f"| {scene} | {kind} | {mode} | {j['build_ms']:.1f} | {j['mrays_per_s']:.2f} | {j['mrays_per_s_with_setup']:.2f} | {j['nodes']} | {j['bytes_per_tri']:.1f} | {j['depth']} |")
+print(f"| {scene} | {kind} | {mode} | {j['build_ms']:.1f} | {j['mrays_per_s']:.2f} | {j['mrays_per_s_prebuilt']:.2f} | {j['setup_ns_per_ray']:.1f} | {j['nodes']} | {j['bytes_per_tri']:.1f} | {j['depth']} |")
 PY
         done
     done

@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
 # Checks baked files on the shared scenes: for each scene, mode (f32, fixed) and tree (bvh,
-# bvh4), `host bake` then `host trace-baked` (load in place, all checks, no build) must give
-# hit files byte-identical to `host trace` building the same tree in process.
+# bvh4), `raykernel bake` then `raykernel trace-baked` (load in place, all checks, no build) must give
+# hit files byte-identical to `raykernel trace` building the same tree in process.
 #
 # usage: host/scripts/check_baked.sh RAYS_DIR
 #
 # RAYS_DIR holds NAME.primary.rays and NAME.incoherent.rays, as written by
 #   python3 ../shared/bench/make_rays.py --out RAYS_DIR suzanne
 # Environment: SCENES (default "suzanne"), KINDS (default "primary incoherent"), SCENES_DIR
-# (default ../shared/scenes beside the workspace), HOST_BIN (default target/release/host).
+# (default ../shared/scenes beside the workspace), HOST_BIN (default target/release/raykernel).
 set -euo pipefail
 
 if [ $# -ne 1 ] || [ ! -d "$1" ]; then
@@ -20,7 +20,7 @@ root=$(cd "$(dirname "$0")/../.." && pwd)
 scenes=${SCENES:-suzanne}
 kinds=${KINDS:-primary incoherent}
 scenes_dir=${SCENES_DIR:-$root/../shared/scenes}
-host=${HOST_BIN:-$root/target/release/host}
+host=${HOST_BIN:-$root/target/release/raykernel}
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 checked=0

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Checks `host trace` on the shared scenes: every BVH builder, the 4-wide BVH, the uniform grid
+# Checks `raykernel trace` on the shared scenes: every BVH builder, the 4-wide BVH, the uniform grid
 # and the kd-tree against brute force, byte for byte.
 #
 # usage: host/scripts/check_trace.sh RAYS_DIR
@@ -20,7 +20,7 @@
 #
 # Environment: STRIDE (default 64), SCENES (default "bunny sponza kitchen"),
 # KINDS (default "primary incoherent"), SCENES_DIR (default ../shared/scenes beside the
-# workspace), HOST_BIN (default: build and use target/release/host), OUT (directory for hit
+# workspace), HOST_BIN (default: build and use target/release/raykernel), OUT (directory for hit
 # files; default a temporary one, removed at the end).
 set -euo pipefail
 
@@ -42,7 +42,7 @@ if [ -z "${HOST_BIN:-}" ]; then
     cargo build --quiet --release --manifest-path "$root/Cargo.toml" -p raykernel-host
     target_dir=$(cargo metadata --format-version 1 --no-deps --manifest-path "$root/Cargo.toml" |
         python3 -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')
-    HOST_BIN=$target_dir/release/host
+    HOST_BIN=$target_dir/release/raykernel
 fi
 if [ -n "${OUT:-}" ]; then
     out=$OUT
@@ -54,7 +54,7 @@ fi
 
 failures=0
 
-# trace LABEL OUT_FILE ARGS...: runs `host trace`, prints one summary line from its JSON.
+# trace LABEL OUT_FILE ARGS...: runs `raykernel trace`, prints one summary line from its JSON.
 trace() {
     local label=$1 hits=$2
     shift 2
@@ -85,7 +85,7 @@ for scene in $scenes; do
         for mode in $modes; do
             tag=$scene.$kind.$mode
             for b in $builders; do
-                trace "$tag $b" "$out/$tag.$b.hits" "$obj" "$rays" --mode "$mode" --builder "$b"
+                trace "$tag $b" "$out/$tag.$b.hits" "$obj" "$rays" --mode "$mode" --accel bvh --builder "$b"
             done
             for a in $accels; do
                 trace "$tag $a" "$out/$tag.$a.hits" "$obj" "$rays" --mode "$mode" --accel "$a"
@@ -97,7 +97,7 @@ for scene in $scenes; do
                 --mode "$mode" --accel linear --stride "$stride"
             for b in $builders; do
                 trace "$tag $b /$stride" "$out/$tag.$b.s$stride.hits" "$obj" "$rays" \
-                    --mode "$mode" --builder "$b" --stride "$stride"
+                    --mode "$mode" --accel bvh --builder "$b" --stride "$stride"
                 same "$tag $b == linear (/$stride)" "$out/$tag.$b.s$stride.hits" \
                     "$out/$tag.linear.s$stride.hits"
             done

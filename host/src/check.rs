@@ -154,6 +154,12 @@ pub struct CaseReport {
     pub differences: Vec<(String, PixelDiff)>,
 }
 
+/// Renders per scene and mode: the reference and every [`variants`] entry.
+#[must_use]
+pub fn renders_per_case() -> usize {
+    variants().len() + 1
+}
+
 /// Renders `spec` (at its own settings) in `mode` every way and compares each with the
 /// kernel's single-threaded whole-image render.
 ///
@@ -161,11 +167,25 @@ pub struct CaseReport {
 /// A scene the kernel rejects (as [`SceneSpec::explain`]) or a thread pool that cannot start.
 /// Differences are not errors: they are in the report.
 pub fn check_scene(spec: &SceneSpec, mode: Mode) -> Result<CaseReport, Error> {
+    check_scene_with(spec, mode, &mut || ())
+}
+
+/// As [`check_scene`], calling `rendered` after each of the [`renders_per_case`] renders
+/// (for progress).
+///
+/// # Errors
+/// As [`check_scene`].
+pub fn check_scene_with(
+    spec: &SceneSpec,
+    mode: Mode,
+    rendered: &mut dyn FnMut(),
+) -> Result<CaseReport, Error> {
     let data = spec.data();
     let settings = spec.settings;
     let name = mode_name(mode);
     let reference = render_reference(&data, settings, mode, AccelChoice::default())
         .map_err(|e| spec.explain(&e, name))?;
+    rendered();
     let mut report = CaseReport {
         scene: spec.name.clone(),
         mode: name,
@@ -189,6 +209,7 @@ pub fn check_scene(spec: &SceneSpec, mode: Mode) -> Result<CaseReport, Error> {
             })?
             .frame
             .srgb8();
+        rendered();
         report.compared += 1;
         if let Some(d) = first_difference(&reference, &image) {
             report.differences.push((v.describe(), d));

@@ -11,6 +11,9 @@
 //!   a point near both triangles. At most the bound: the two triangles come that close to each
 //!   other where the ray meets them (surfaces crossing or touching, e.g. walls meeting in a
 //!   corner), so quantization can swap which is nearer.
+//! - **origin**: otherwise, when the nearer of the two hits lies within the bound of the ray's
+//!   origin: quantizing the origin can put that surface behind the ray's start (a ray leaving
+//!   a surface, as secondary rays do), so the other side sees the next surface instead.
 //! - anything else is unexplained: one side missed a triangle that the ray meets well inside,
 //!   or picked the farther of two well separated ones.
 
@@ -40,6 +43,9 @@ pub struct Classification {
     /// Other differing rays where the two reported triangles are within the bound of each other
     /// at the ray (a depth tie that quantization can swap).
     pub explained_by_depth: usize,
+    /// Other differing rays whose nearer hit lies within the bound of the ray's origin
+    /// (quantizing the origin can put that surface behind the ray's start).
+    pub explained_by_origin: usize,
     /// The rest: neither explanation holds.
     pub unexplained: usize,
     /// Largest edge distance (minimum over both triangles) among the differing rays; 0 if none.
@@ -134,6 +140,7 @@ pub fn classify(
         differing: 0,
         explained_by_quantization: 0,
         explained_by_depth: 0,
+        explained_by_origin: 0,
         unexplained: 0,
         max_edge_distance_of_differing: 0.0,
         bound: BOUND_FORMULA,
@@ -146,6 +153,7 @@ pub fn classify(
         c.differing += 1;
         let mut tris = [None, None];
         let mut t = 0.0f64;
+        let mut nearest = f64::INFINITY;
         for (slot, h) in tris.iter_mut().zip([a, b]) {
             if !h.is_hit() {
                 continue;
@@ -160,6 +168,7 @@ pub fn classify(
                 })?;
             *slot = Some(tri.map(|k| mesh.positions[k as usize].map(f64::from)));
             t = t.max(f64::from(h.t));
+            nearest = nearest.min(f64::from(h.t));
         }
         let bound = quantization_bound(t);
         let edge = tris
@@ -178,6 +187,10 @@ pub fn classify(
         };
         if depth <= bound {
             c.explained_by_depth += 1;
+            continue;
+        }
+        if nearest <= bound {
+            c.explained_by_origin += 1;
             continue;
         }
         c.unexplained += 1;
@@ -605,6 +618,15 @@ mod tests {
         let b = [h(5.0, 0), h(5.0, 1), h(5.0, 2), HitRecord::MISS];
         let c = classify(&a, &b, &rays, &walled).unwrap();
         assert_eq!((c.explained_by_depth, c.unexplained), (1, 0));
+
+        // A ray leaving triangle 0 (origin a hair above its plane): one side hits it at once,
+        // the other (origin quantized behind it) reports another surface, far from its edges.
+        let mut leaving = rays;
+        leaving[2] = RayRecord::new([0.3, 0.3, 5.0 - eps], down);
+        let near = [h(5.0, 0), h(5.0, 0), h(eps, 0), h(5.0, 1)];
+        let far = [h(5.0, 0), h(5.0, 1), h(3.0, 1), HitRecord::MISS];
+        let c = classify(&near, &far, &leaving, &mesh).unwrap();
+        assert_eq!((c.explained_by_origin, c.unexplained), (1, 0));
 
         let bad = [h(5.0, 0), h(5.0, 0), h(5.0, 7), h(5.0, 1)];
         assert_eq!(

@@ -1,33 +1,44 @@
 //! The command line: argument types (clap derive) and the commands behind them.
 //!
-//! Each command returns the JSON object `main` prints as the last line of stdout.
+//! Each command returns the JSON object `main` prints as the last line of stdout; lines for
+//! people go through a [`Console`] as the work happens.
 
 use crate::bake::{run_bake, run_trace_baked, BakeArgs, TraceBakedArgs};
-use crate::check::{check_scene, describe_differences, CaseReport};
+use crate::check::{check_scene_with, describe_differences, renders_per_case, CaseReport};
 use crate::classify::{classify, Classification};
 use crate::compare::{compare_hits, Comparison, DEFAULT_REL};
+use crate::console::Console;
 use crate::error::Error;
-use crate::obj::load_obj;
-use crate::rayfile::{read_hits, read_rays, write_hits};
+use crate::limits::{check_memory, check_settings, render_bytes, MAX_DEPTH, MAX_SIDE, MAX_SPP};
+use crate::obj::{load_obj, point_error_text};
+use crate::output::{Format, Reserved};
+use crate::rayfile::{read_hits, read_rays, write_hits, RayRecord};
 use crate::render::{
-    accel_choice, accel_name, mode_name, plan, render, write_pfm, write_png, RenderError,
+    accel_choice, accel_name, encode_pfm, encode_png, mode_name, plan, render, RenderError,
     RenderOptions,
 };
 use crate::scene::{resolve_scene, DEFAULT_SCENE};
-use crate::scenefile::{write_scene_file, FilterName, SamplerName};
-use crate::spec::{SceneOrigin, SceneSpec};
+use crate::scenefile::{scene_file_text, spec_to_scene_file, FilterName, SamplerName};
+use crate::spec::{eye_to_look_at, SceneOrigin, SceneSpec};
 use crate::trace::{trace, AccelKind, Builder, Mode, TraceConfig};
 use clap::builder::RangedU64ValueParser;
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, CommandFactory, Parser, Subcommand};
 use raykernel::bvh::{BuildOptions, BuilderKind, DEFAULT_LEAF_SIZE, MAX_LEAF_SIZE};
-use raykernel::render::{scenes, Settings};
+use raykernel::render::{scenes, AccelChoice, Camera, RenderPlan, Settings};
+use raykernel::{Ray, RayError, Scalar, I16F16};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
+/// The program's name, as installed and as shown in help and completions.
+pub const PROGRAM: &str = "raykernel";
+
 /// Command-line host for raykernel.
 #[derive(Debug, Parser)]
-#[command(name = "host", version, about)]
+#[command(name = PROGRAM, version, about)]
 pub struct Cli {
+    /// Print only the JSON report (and warnings and errors): no summaries, no progress.
+    #[arg(long, short, global = true)]
+    pub quiet: bool,
     /// What to do.
     #[command(subcommand)]
     pub command: Command,
@@ -42,9 +53,6 @@ pub enum Command {
     /// --scene and --rays, also check each differing ray passes within quantization error of an
     /// edge of a reported triangle.
     CompareHits(CompareArgs),
-    /// Benchmark speed and accuracy on the shared scenes, with peers in the same run; writes
-    /// BENCHMARKS.md, data.csv, data.json and plots/ into --out.
-    Bench(BenchArgs),
     /// Render a scene with the distribution ray tracer: a built-in scene (default `cornell`),
     /// a scene file (.json, see docs/SCENE_FORMAT.md) or an OBJ mesh; PNG out, optionally
     /// linear PFM; parallel over tiles.
@@ -52,6 +60,9 @@ pub enum Command {
     /// Render scenes every way (kernel single-threaded, host tiles at several thread counts
     /// and tile sizes, every accelerator) and check all are byte-identical.
     Check(CheckArgs),
+    /// Print a shell completion script, e.g. `raykernel completions bash >
+    /// ~/.local/share/bash-completion/completions/raykernel`.
+    Completions(CompletionsArgs),
     /// Build a BVH or 4-wide BVH over an OBJ mesh and write it with its triangles as a baked
     /// file (docs/BAKED_FORMAT.md), to be loaded in place on a device.
     Bake(BakeArgs),
@@ -59,21 +70,30 @@ pub enum Command {
     TraceBaked(TraceBakedArgs),
 }
 
+/// `raykernel completions SHELL`.
+#[derive(Clone, Debug, Args)]
+pub struct CompletionsArgs {
+    /// The shell.
+    #[arg(value_enum)]
+    pub shell: clap_complete::Shell,
+}
+
 /// Settings a command line may override (scene or file settings otherwise).
 #[derive(Clone, Debug, Default, Args)]
 pub struct SettingsArgs {
-    /// Image width in pixels [default: the scene file's, else 512].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    /// Image width in pixels; alone, the height follows at the scene's aspect ratio
+    /// (width × height ≤ 67108864) [default: the scene file's, else 512].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_SIDE)))]
     pub width: Option<u32>,
-    /// Image height in pixels [default: the scene file's, else 512 (built-ins keep their
-    /// aspect ratio)].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    /// Image height in pixels; alone, the width follows at the scene's aspect ratio
+    /// [default: the scene file's, else 512; built-ins: their aspect ratio at width 512].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_SIDE)))]
     pub height: Option<u32>,
     /// Samples per pixel [default: the scene file's, else 64].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_SPP)))]
     pub spp: Option<u32>,
     /// Most reflection bounces [default: the scene's].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=64))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(MAX_DEPTH)))]
     pub max_depth: Option<u32>,
     /// Sample placement [default: the scene's].
     #[arg(long, value_enum)]
@@ -86,13 +106,29 @@ pub struct SettingsArgs {
     pub seed: Option<u32>,
 }
 
+/// `side × numerator / denominator`, rounded to the nearest integer, at least 1: the other side
+/// of an image of aspect `numerator : denominator`.
+#[must_use]
+pub fn keep_aspect(side: u32, numerator: u32, denominator: u32) -> u32 {
+    let scaled = (u64::from(side) * u64::from(numerator) + u64::from(denominator) / 2)
+        / u64::from(denominator.max(1));
+    u32::try_from(scaled.max(1)).unwrap_or(u32::MAX)
+}
+
 impl SettingsArgs {
-    /// `base` with every given flag applied.
+    /// `base` with every given flag applied; a width or height given alone keeps `base`'s
+    /// aspect ratio.
     #[must_use]
     pub fn apply(&self, base: Settings) -> Settings {
+        let (width, height) = match (self.width, self.height) {
+            (Some(w), Some(h)) => (w, h),
+            (Some(w), None) => (w, keep_aspect(w, base.height, base.width)),
+            (None, Some(h)) => (keep_aspect(h, base.width, base.height), h),
+            (None, None) => (base.width, base.height),
+        };
         Settings {
-            width: self.width.unwrap_or(base.width),
-            height: self.height.unwrap_or(base.height),
+            width,
+            height,
             spp: self.spp.unwrap_or(base.spp),
             max_depth: self.max_depth.unwrap_or(base.max_depth),
             sampler: self.sampler.map_or(base.sampler, Into::into),
@@ -102,19 +138,82 @@ impl SettingsArgs {
     }
 }
 
-/// `host render [SCENE] --out FILE.png [options]`.
+/// A point or vector on the command line: `x,y,z`.
+fn parse_xyz(text: &str) -> Result<[f32; 3], String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let [x, y, z] = parts[..] else {
+        return Err(format!(
+            "expected three numbers `x,y,z`, found {} part(s)",
+            parts.len()
+        ));
+    };
+    let number = |t: &str| match t.parse::<f32>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(format!("`{t}` is not a finite number")),
+    };
+    Ok([number(x)?, number(y)?, number(z)?])
+}
+
+/// Camera settings a command line may override (the scene's camera otherwise).
+#[derive(Clone, Debug, Default, Args)]
+pub struct CameraArgs {
+    /// Lens centre `x,y,z`.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_xyz, allow_hyphen_values = true)]
+    pub eye: Option<[f32; 3]>,
+    /// A point on the optical axis `x,y,z`.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_xyz, allow_hyphen_values = true)]
+    pub look_at: Option<[f32; 3]>,
+    /// Up hint `x,y,z`.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_xyz, allow_hyphen_values = true)]
+    pub up: Option<[f32; 3]>,
+    /// Full vertical field of view, degrees, strictly between 0 and 180.
+    #[arg(long, value_name = "DEGREES")]
+    pub vfov: Option<f32>,
+    /// Lens radius in world units (0: pinhole).
+    #[arg(long, value_name = "RADIUS")]
+    pub aperture: Option<f32>,
+    /// Distance to the plane in focus [default: the scene's; from eye to look-at when
+    /// --eye or --look-at is given].
+    #[arg(long, value_name = "DISTANCE")]
+    pub focus: Option<f32>,
+}
+
+impl CameraArgs {
+    /// `base` with every given flag applied. Lights stay where the scene put them.
+    #[must_use]
+    pub fn apply(&self, base: Camera) -> Camera {
+        let eye = self.eye.unwrap_or(base.eye);
+        let look_at = self.look_at.unwrap_or(base.look_at);
+        let moved = self.eye.is_some() || self.look_at.is_some();
+        Camera {
+            eye,
+            look_at,
+            up: self.up.unwrap_or(base.up),
+            vfov_deg: self.vfov.unwrap_or(base.vfov_deg),
+            aperture_radius: self.aperture.unwrap_or(base.aperture_radius),
+            focus_distance: self.focus.unwrap_or(if moved {
+                eye_to_look_at(eye, look_at)
+            } else {
+                base.focus_distance
+            }),
+        }
+    }
+}
+
+/// `raykernel render [SCENE] --out FILE.png [options]`.
 #[derive(Clone, Debug, Args)]
 pub struct RenderArgs {
     /// A built-in scene (cornell, spheres, motion), a scene file (.json) or an OBJ mesh (.obj,
     /// camera from NAME.camera beside it or framed) [default: cornell].
     pub scene: Option<String>,
-    /// The PNG to write (8-bit sRGB).
-    #[arg(long, required_unless_present_any = ["explain", "dump_scene"])]
+    /// The PNG to write (8-bit sRGB; the name must end in `.png`). Checked before rendering.
+    #[arg(long, value_name = "FILE.png", required_unless_present_any = ["explain", "dump_scene"])]
     pub out: Option<PathBuf>,
     /// Also write the linear image (mean radiance per pixel, unclipped) as a PFM file.
     #[arg(long, value_name = "FILE.pfm")]
     pub linear: Option<PathBuf>,
-    /// Write the scene, with the settings this command would render it with, as a scene file.
+    /// Write the scene, with the settings and camera this command would render it with, as a
+    /// scene file (meshes read from OBJ files are named, relative to it, not inlined).
     #[arg(long, value_name = "FILE.json")]
     pub dump_scene: Option<PathBuf>,
     /// Print the render plan (what the kernel will do) and exit without rendering.
@@ -123,6 +222,9 @@ pub struct RenderArgs {
     /// Settings.
     #[command(flatten)]
     pub settings: SettingsArgs,
+    /// Camera.
+    #[command(flatten)]
+    pub camera: CameraArgs,
     /// Number mode of the kernel's geometry.
     #[arg(long, value_enum, default_value_t = Mode::F32)]
     pub mode: Mode,
@@ -147,10 +249,10 @@ pub struct RenderArgs {
     pub tile: u32,
 }
 
-/// `host check [SCENE...]`.
+/// `raykernel check [SCENE...]`.
 #[derive(Clone, Debug, Args)]
 pub struct CheckArgs {
-    /// Scenes as for `host render` [default: every built-in scene].
+    /// Scenes as for `raykernel render` [default: every built-in scene].
     pub scenes: Vec<String>,
     /// Only this mode [default: both].
     #[arg(long, value_enum)]
@@ -160,7 +262,7 @@ pub struct CheckArgs {
     pub settings: SettingsArgs,
 }
 
-/// The JSON report of `host render`.
+/// The JSON report of `raykernel render`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RenderReport {
     /// Scene name.
@@ -218,10 +320,16 @@ pub struct RenderFigures {
 }
 
 impl RenderReport {
-    /// Lines for people: the plan, then what was rendered and how fast, or what was written.
+    /// The line for people printed before rendering: `plan: ...`.
+    #[must_use]
+    pub fn plan_line(&self) -> String {
+        format!("plan: {}", self.plan)
+    }
+
+    /// Lines for people after the work: what was rendered and how fast, what was written.
     #[must_use]
     pub fn summary(&self) -> String {
-        let mut lines = vec![format!("plan: {}", self.plan)];
+        let mut lines = Vec::new();
         if let Some(f) = &self.figures {
             let m = |n: u64| n as f64 / 1e6;
             lines.push(format!(
@@ -253,7 +361,7 @@ impl RenderReport {
     }
 }
 
-/// The JSON report of `host check`.
+/// The JSON report of `raykernel check`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct CheckReport {
     /// One entry per scene and mode.
@@ -264,7 +372,7 @@ pub struct CheckReport {
     pub differences: usize,
 }
 
-/// `host trace SCENE.obj RAYS --out HITS [options]`.
+/// `raykernel trace SCENE.obj RAYS --out HITS [options]`.
 #[derive(Clone, Debug, Args)]
 pub struct TraceArgs {
     /// The scene (Wavefront OBJ).
@@ -274,8 +382,8 @@ pub struct TraceArgs {
     /// Where to write the hits: 8-byte records `t: f32, prim: u32` per traced ray.
     #[arg(long)]
     pub out: PathBuf,
-    /// Accelerator.
-    #[arg(long, value_enum, default_value_t = AccelKind::Bvh)]
+    /// Accelerator (default: the 4-wide BVH, the fastest to trace).
+    #[arg(long, value_enum, default_value_t = AccelKind::Bvh4)]
     pub accel: AccelKind,
     /// BVH builder.
     #[arg(long, value_enum, default_value_t = Builder::Sah)]
@@ -303,7 +411,7 @@ pub struct TraceArgs {
     pub leaf_order: bool,
 }
 
-/// `host compare-hits REF OTHER [--rel R] [--scene OBJ --rays RAYS]`.
+/// `raykernel compare-hits REF OTHER [--rel R] [--scene OBJ --rays RAYS]`.
 #[derive(Clone, Debug, Args)]
 pub struct CompareArgs {
     /// The reference hit file.
@@ -321,8 +429,8 @@ pub struct CompareArgs {
     pub rays: Option<PathBuf>,
 }
 
-/// The JSON report of `host compare-hits`: the agreement figures, plus the classification of the
-/// differing rays when `--scene` and `--rays` are given.
+/// The JSON report of `raykernel compare-hits`: the agreement figures, plus the classification
+/// of the differing rays when `--scene` and `--rays` are given.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct CompareReport {
     /// Agreement figures.
@@ -333,81 +441,7 @@ pub struct CompareReport {
     pub classification: Option<Classification>,
 }
 
-/// `host bench [--quick] [--rays DIR | --rust-rays] [--out DIR] [options]`.
-#[derive(Clone, Debug, Args)]
-pub struct BenchArgs {
-    /// CI smoke test: every 64th ray, one run, scale sweep up to 100k triangles.
-    #[arg(long)]
-    pub quick: bool,
-    /// Directory of the scenes (NAME.obj, NAME.camera).
-    #[arg(long, value_name = "DIR", default_value = "../shared/scenes")]
-    pub scenes: PathBuf,
-    /// Scenes to run (repeatable).
-    #[arg(long = "scene", value_name = "NAME", default_values_t = ["bunny".to_string(), "sponza".to_string(), "kitchen".to_string()])]
-    pub scene_names: Vec<String>,
-    /// Ray files from `make_rays.py --out DIR` [default: run make_rays.py into a temp dir].
-    #[arg(long, value_name = "DIR", conflicts_with = "rust_rays")]
-    pub rays: Option<PathBuf>,
-    /// Generate the rays in Rust instead (primary by WORKLOAD.md's camera formula,
-    /// incoherent from SplitMix64: not the files' rays).
-    #[arg(long)]
-    pub rust_rays: bool,
-    /// Rays per set with --rust-rays.
-    #[arg(long, value_name = "N", default_value_t = 1 << 20,
-          value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
-    pub rays_per_set: usize,
-    /// Output directory.
-    #[arg(long, value_name = "DIR", default_value = "docs/bench")]
-    pub out: PathBuf,
-    /// Trace every K-th ray [default: 1, or 64 with --quick].
-    #[arg(long, value_name = "K", value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
-    pub stride: Option<usize>,
-    /// Runs per figure, medians [default: 3, or 1 with --quick].
-    #[arg(long, value_name = "N", value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
-    pub runs: Option<usize>,
-    /// Skip the peers.
-    #[arg(long)]
-    pub no_peers: bool,
-    /// Interleaved rounds per ray set: the headline contender and tinybvh's BVH2 (with the
-    /// `tinybvh` feature) traced in alternation; `0` skips them [default: 7, or 2 with --quick].
-    #[arg(long, value_name = "N")]
-    pub rounds: Option<usize>,
-    /// Tiled-scene sizes in triangles, comma-separated; `0` skips the sweep
-    /// [default: 10k..2M, or 10k..100k with --quick].
-    #[arg(long, value_name = "N,N,...", value_delimiter = ',')]
-    pub scale: Option<Vec<usize>>,
-    /// Rays per set in the scale sweep [default: 262144, or 16384 with --quick].
-    #[arg(long, value_name = "N", value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
-    pub scale_rays: Option<usize>,
-    /// Skip the image-convergence renders (RMSE against time per sampler).
-    #[arg(long)]
-    pub no_images: bool,
-    /// Largest sample count of the image renders (1, 2, 4, … up to it; the reference uses 16
-    /// times as many) [default: 256, or 16 with --quick].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=65536))]
-    pub image_spp: Option<u32>,
-}
-
-/// The JSON report of `host bench`: where the files went, and the run's size.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct BenchReport {
-    /// The Markdown report.
-    pub report: String,
-    /// The CSV.
-    pub csv: String,
-    /// The JSON.
-    pub json: String,
-    /// PNG plots.
-    pub plots: Vec<String>,
-    /// Trace rows (ours and peers).
-    pub rows: usize,
-    /// Scale rows.
-    pub scale_rows: usize,
-    /// Wall time, seconds.
-    pub elapsed_s: f64,
-}
-
-/// The JSON report of `host trace`.
+/// The JSON report of `raykernel trace`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TraceReport {
     /// Scene path.
@@ -416,7 +450,7 @@ pub struct TraceReport {
     pub rays_file: String,
     /// Hit file path.
     pub out: String,
-    /// `bvh`, `linear`, `grid` or `kdtree`.
+    /// `bvh4`, `bvh`, `linear`, `grid` or `kdtree`.
     pub accel: &'static str,
     /// `sah`, `median` or `midpoint`; `null` for linear.
     pub builder: Option<&'static str>,
@@ -436,26 +470,37 @@ pub struct TraceReport {
     pub triangles: usize,
     /// Median wall time of the build, leaf-order permutation included (0 for linear).
     pub build_ms: f64,
-    /// Median wall time of turning records into kernel rays, before tracing.
+    /// Median wall time of constructing each kernel ray from its record and tracing it, one
+    /// record at a time (what a caller pays; no file I/O).
+    pub per_ray_ms: f64,
+    /// Median wall time of turning records into kernel rays, ahead of tracing.
     pub setup_ms: f64,
-    /// Median wall time of tracing and storing every traced ray (no setup, no file I/O).
+    /// Median wall time of tracing and storing every pre-built ray (no setup, no file I/O).
     pub trace_ms: f64,
     /// Build time of each run.
     pub build_ms_runs: Vec<f64>,
-    /// Trace time of each run.
+    /// Per-ray time (construction included) of each run.
+    pub per_ray_ms_runs: Vec<f64>,
+    /// Pre-built trace time of each run.
     pub trace_ms_runs: Vec<f64>,
     /// Rays traced.
     pub rays: usize,
     /// Rays in the file.
     pub rays_in_file: usize,
-    /// Million rays per second of the median trace time.
+    /// Million rays per second, each ray constructed from its record and traced (`per_ray_ms`).
     pub mrays_per_s: f64,
-    /// Million rays per second counting setup as well.
-    pub mrays_per_s_with_setup: f64,
+    /// Million rays per second of tracing pre-built rays (`trace_ms`: construction excluded).
+    pub mrays_per_s_prebuilt: f64,
+    /// Cost of constructing one kernel ray from its record, ns (`setup_ms` per ray).
+    pub setup_ns_per_ray: f64,
     /// Rays that hit.
     pub hits: usize,
     /// Rays the kernel rejected, written as misses.
     pub bad_rays: usize,
+    /// The first rejected ray: its index in the ray file, `null` if none.
+    pub first_bad_ray: Option<usize>,
+    /// Why the kernel rejected it, `null` if none.
+    pub first_bad_ray_error: Option<String>,
     /// BVH nodes (bvh4: 4-wide nodes; 0 for linear).
     pub nodes: usize,
     /// Bytes of BVH nodes and primitive ids per triangle (bvh4: its 4-wide nodes and the ids;
@@ -465,57 +510,67 @@ pub struct TraceReport {
     pub depth: u32,
 }
 
-/// Runs a parsed command line; returns what to print: the command's one-line JSON report as
-/// the last line (`render` puts a summary line for people before it).
+/// Runs a parsed command line: lines for people go to `console` as the work happens; returns
+/// the command's one-line JSON report, which `main` prints as the last line of stdout.
 ///
 /// # Errors
 /// Whatever the command fails with.
-pub fn run(cli: &Cli) -> Result<String, Error> {
-    let (summary, json) = match &cli.command {
-        Command::Trace(args) => (None, serde_json::to_string(&run_trace(args)?)),
-        Command::CompareHits(args) => (None, serde_json::to_string(&run_compare(args)?)),
-        Command::Bake(args) => (None, serde_json::to_string(&run_bake(args)?)),
-        Command::TraceBaked(args) => (None, serde_json::to_string(&run_trace_baked(args)?)),
-        Command::Bench(args) => (None, serde_json::to_string(&run_bench(args)?)),
+pub fn run(cli: &Cli, console: &Console) -> Result<String, Error> {
+    let json = match &cli.command {
+        Command::Trace(args) => {
+            let report = run_trace(args)?;
+            if let Some(line) = report.rejected_rays_warning() {
+                console.warn(&line);
+            }
+            serde_json::to_string(&report)
+        }
+        Command::CompareHits(args) => serde_json::to_string(&run_compare(args)?),
+        Command::Bake(args) => serde_json::to_string(&run_bake(args)?),
+        Command::TraceBaked(args) => serde_json::to_string(&run_trace_baked(args)?),
         Command::Render(args) => {
-            let report = run_render(args)?;
-            (Some(report.summary()), serde_json::to_string(&report))
+            let job = RenderJob::prepare(args)?;
+            console.line(&job.report.plan_line());
+            let report = job.run(console)?;
+            let summary = report.summary();
+            if !summary.is_empty() {
+                console.line(&summary);
+            }
+            serde_json::to_string(&report)
         }
         Command::Check(args) => {
-            let report = run_check(args)?;
-            let line = format!(
+            let report = run_check_with(args, console)?;
+            console.line(&format!(
                 "check passed: {} renders of {} scene/mode cases identical to the kernel's",
                 report.renders,
                 report.cases.len()
-            );
-            (Some(line), serde_json::to_string(&report))
+            ));
+            serde_json::to_string(&report)
+        }
+        Command::Completions(args) => {
+            let mut script = Vec::new();
+            clap_complete::generate(args.shell, &mut Cli::command(), PROGRAM, &mut script);
+            return Ok(String::from_utf8_lossy(&script).trim_end().to_string());
         }
     };
     // Structs of numbers and strings always serialize; the fallback only avoids a panic path.
-    let json = json.unwrap_or_else(|e| format!("{{\"error\":\"cannot encode report: {e}\"}}"));
-    Ok(match summary {
-        Some(line) => format!("{line}\n{json}"),
-        None => json,
-    })
+    Ok(json.unwrap_or_else(|e| format!("{{\"error\":\"cannot encode report: {e}\"}}")))
 }
 
-/// Samples per pixel of `host render` for built-in scenes (their own settings are the small
-/// ones of the snapshot tests).
+/// Samples per pixel of `raykernel render` for built-in scenes (their own settings are the
+/// small ones of the snapshot tests).
 pub const BUILT_IN_SPP: u32 = 64;
-/// Width of `host render` for built-in scenes; the height keeps the scene's aspect ratio.
+/// Width of `raykernel render` for built-in scenes; the height keeps the scene's aspect ratio.
 pub const BUILT_IN_WIDTH: u32 = 512;
 
-/// The settings `host render` uses for `spec` before command-line flags: a scene file's or an
-/// OBJ's own; for a built-in, 512 pixels wide (its aspect kept) at 64 spp.
+/// The settings `raykernel render` uses for `spec` before command-line flags: a scene file's
+/// or an OBJ's own; for a built-in, 512 pixels wide (its aspect kept) at 64 spp.
 #[must_use]
 pub fn render_base_settings(spec: &SceneSpec) -> Settings {
     let s = spec.settings;
     match spec.origin {
         SceneOrigin::BuiltIn => Settings {
             width: BUILT_IN_WIDTH,
-            height: ((u64::from(BUILT_IN_WIDTH) * u64::from(s.height) + u64::from(s.width) / 2)
-                / u64::from(s.width.max(1)))
-            .clamp(1, 16384) as u32,
+            height: keep_aspect(BUILT_IN_WIDTH, s.height, s.width),
             spp: BUILT_IN_SPP,
             ..s
         },
@@ -530,99 +585,216 @@ fn render_error(spec: &SceneSpec, mode: Mode) -> impl Fn(RenderError) -> Error +
     }
 }
 
-/// `host render`: load the scene, then dump it, explain the plan, or render and write images.
+/// Checks what `spec` asks of a render in `mode` before any work and returns the plan: the
+/// settings' bounds and the memory the render needs (with the linear image if `linear`),
+/// then what the kernel checks (the plan), then the camera ([`SceneSpec::check_camera`]).
 ///
 /// # Errors
-/// An unknown scene, a bad or unreadable scene file, OBJ or `.camera` file, a scene the
-/// kernel rejects in the chosen mode, or an unwritable output.
-pub fn run_render(args: &RenderArgs) -> Result<RenderReport, Error> {
-    let mut spec = resolve_scene(args.scene.as_deref().unwrap_or(DEFAULT_SCENE))?;
-    spec.settings = args.settings.apply(render_base_settings(&spec));
-    let settings = spec.settings;
-    let data = spec.data();
-    let mode = args.mode;
-    if args.accel == AccelKind::Bvh4 {
-        return Err(Error::Usage(
-            "--accel bvh4 is for `host trace` only: the renderer has no 4-wide BVH".into(),
-        ));
-    }
-    let accel = accel_choice(
-        args.accel,
-        BuildOptions {
-            builder: args.builder.into(),
-            max_leaf_size: args.leaf,
-            reinsertion: !args.no_reinsertion,
-        },
+/// [`Error::Scene`] naming the setting or field.
+pub fn check_render_request(
+    spec: &SceneSpec,
+    mode: Mode,
+    linear: bool,
+) -> Result<RenderPlan, Error> {
+    let at = |e: crate::limits::OverLimit| Error::Scene {
+        file: spec.label(),
+        field: e.field.into(),
+        msg: e.msg,
+    };
+    check_settings(&spec.settings).map_err(at)?;
+    let needed = render_bytes(
+        &spec.settings,
+        spec.triangles.len(),
+        spec.spheres.len(),
+        linear,
     );
-    let the_plan = plan(&data, settings, mode).map_err(|e| spec.explain(&e, mode_name(mode)))?;
-    if let Some(path) = &args.dump_scene {
-        write_scene_file(path, &data, &spec.material_names)?;
-    }
-    let mut report = RenderReport {
-        scene: spec.name.clone(),
-        source: match &spec.origin {
-            SceneOrigin::BuiltIn => "built-in".into(),
-            SceneOrigin::File(p) | SceneOrigin::Obj(p) => p.display().to_string(),
-        },
-        out: None,
-        linear: None,
-        dump_scene: args.dump_scene.as_ref().map(|p| p.display().to_string()),
-        width: settings.width,
-        height: settings.height,
-        spp: settings.spp,
-        mode: mode_name(mode),
-        accel: accel_name(accel),
-        triangles: spec.triangles.len(),
-        spheres: spec.spheres.len(),
-        plan: the_plan.to_string(),
-        figures: None,
-    };
-    let Some(out) = args.out.as_ref().filter(|_| !args.explain) else {
-        return Ok(report);
-    };
-    let threads = args.threads.unwrap_or_else(|| {
-        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
-    });
-    let options = RenderOptions {
-        mode,
-        accel,
-        threads,
-        tile: (args.tile, args.tile),
-        progress: true,
-    };
-    let r = render(&data, settings, &options).map_err(render_error(&spec, mode))?;
-    write_png(out, &r.frame.srgb8())?;
-    if let Some(path) = &args.linear {
-        write_pfm(path, &r.frame)?;
-        report.linear = Some(path.display().to_string());
-    }
-    report.out = Some(out.display().to_string());
-    let rays = r.stats.rays();
-    report.figures = Some(RenderFigures {
-        threads,
-        tile: args.tile,
-        build_ms: r.build_ms,
-        render_ms: r.render_ms,
-        camera_rays: r.stats.camera_rays,
-        shadow_rays: r.stats.shadow_rays,
-        reflection_rays: r.stats.reflection_rays,
-        rays,
-        mrays_per_s: if r.render_ms > 0.0 {
-            rays as f64 / r.render_ms / 1e3
-        } else {
-            0.0
-        },
-    });
-    Ok(report)
+    check_memory(needed).map_err(at)?;
+    let the_plan =
+        plan(&spec.data(), spec.settings, mode).map_err(|e| spec.explain(&e, mode_name(mode)))?;
+    spec.check_camera(mode_name(mode))?;
+    Ok(the_plan)
 }
 
-/// `host check`: every scene (default: every built-in) in each mode, every way of rendering,
-/// byte for byte.
+/// A render whose inputs are loaded and checked, outputs reserved and plan known: what
+/// `raykernel render` does before the work ([`RenderJob::prepare`]) and the work itself
+/// ([`RenderJob::run`]).
+#[derive(Debug)]
+pub struct RenderJob {
+    spec: SceneSpec,
+    mode: Mode,
+    accel: AccelChoice,
+    threads: usize,
+    tile: u32,
+    out: Option<Reserved>,
+    linear: Option<Reserved>,
+    /// The report so far: everything but the render's figures.
+    pub report: RenderReport,
+}
+
+impl RenderJob {
+    /// Checks the arguments and reserves the output files first (so a bad `--out` fails at
+    /// once), then loads the scene, applies the settings and camera flags, checks them and the
+    /// memory needed, derives the plan and writes the scene file if asked.
+    ///
+    /// # Errors
+    /// A bad output name or directory, an unknown scene, a bad or unreadable scene file, OBJ
+    /// or `.camera` file, settings beyond [`crate::limits`], a scene the kernel rejects in the
+    /// chosen mode.
+    pub fn prepare(args: &RenderArgs) -> Result<Self, Error> {
+        if args.accel == AccelKind::Bvh4 {
+            return Err(Error::Usage(
+                "--accel bvh4 is for `raykernel trace` only: the renderer has no 4-wide BVH".into(),
+            ));
+        }
+        let rendering = !args.explain;
+        let out = match &args.out {
+            Some(p) if rendering => Some(Reserved::new(p, Format::Png, "--out")?),
+            _ => None,
+        };
+        let linear = match &args.linear {
+            Some(p) if rendering => Some(Reserved::new(p, Format::Pfm, "--linear")?),
+            _ => None,
+        };
+        let dump = match &args.dump_scene {
+            Some(p) => Some(Reserved::new(p, Format::SceneFile, "--dump-scene")?),
+            None => None,
+        };
+        let mut spec = resolve_scene(args.scene.as_deref().unwrap_or(DEFAULT_SCENE))?;
+        spec.settings = args.settings.apply(render_base_settings(&spec));
+        spec.camera = args.camera.apply(spec.camera);
+        let mode = args.mode;
+        let the_plan = check_render_request(&spec, mode, linear.is_some())?;
+        let settings = spec.settings;
+        let accel = accel_choice(
+            args.accel,
+            BuildOptions {
+                builder: args.builder.into(),
+                max_leaf_size: args.leaf,
+                reinsertion: !args.no_reinsertion,
+            },
+        );
+        if let Some(file) = dump {
+            let text = scene_file_text(&spec_to_scene_file(&spec, file.path()));
+            file.write(text.as_bytes())?;
+        }
+        let report = RenderReport {
+            scene: spec.name.clone(),
+            source: match &spec.origin {
+                SceneOrigin::BuiltIn => "built-in".into(),
+                SceneOrigin::File(p) | SceneOrigin::Obj(p) => p.display().to_string(),
+            },
+            out: None,
+            linear: None,
+            dump_scene: args.dump_scene.as_ref().map(|p| p.display().to_string()),
+            width: settings.width,
+            height: settings.height,
+            spp: settings.spp,
+            mode: mode_name(mode),
+            accel: accel_name(accel),
+            triangles: spec.triangles.len(),
+            spheres: spec.spheres.len(),
+            plan: the_plan.to_string(),
+            figures: None,
+        };
+        let threads = args.threads.unwrap_or_else(|| {
+            std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+        });
+        Ok(Self {
+            spec,
+            mode,
+            accel,
+            threads,
+            tile: args.tile,
+            out,
+            linear,
+            report,
+        })
+    }
+
+    /// Renders and writes the images (nothing to do with `--explain` or a dump only); a
+    /// progress bar on stderr for long renders unless `console` is quiet.
+    ///
+    /// # Errors
+    /// A scene the kernel rejects while rendering, threads that cannot start, an output that
+    /// cannot be written.
+    pub fn run(self, console: &Console) -> Result<RenderReport, Error> {
+        let Self {
+            spec,
+            mode,
+            accel,
+            threads,
+            tile,
+            out,
+            linear,
+            mut report,
+        } = self;
+        let Some(out) = out else {
+            return Ok(report);
+        };
+        let options = RenderOptions {
+            mode,
+            accel,
+            threads,
+            tile: (tile, tile),
+            progress: !console.quiet,
+        };
+        let r = render(&spec.data(), spec.settings, &options).map_err(render_error(&spec, mode))?;
+        let png = encode_png(&r.frame.srgb8()).map_err(|msg| Error::Output {
+            path: out.path().to_path_buf(),
+            msg,
+        })?;
+        report.out = Some(out.path().display().to_string());
+        out.write(&png)?;
+        if let Some(file) = linear {
+            report.linear = Some(file.path().display().to_string());
+            file.write(&encode_pfm(&r.frame))?;
+        }
+        let rays = r.stats.rays();
+        report.figures = Some(RenderFigures {
+            threads,
+            tile,
+            build_ms: r.build_ms,
+            render_ms: r.render_ms,
+            camera_rays: r.stats.camera_rays,
+            shadow_rays: r.stats.shadow_rays,
+            reflection_rays: r.stats.reflection_rays,
+            rays,
+            mrays_per_s: if r.render_ms > 0.0 {
+                rays as f64 / r.render_ms / 1e3
+            } else {
+                0.0
+            },
+        });
+        Ok(report)
+    }
+}
+
+/// `raykernel render`: load the scene, then dump it, explain the plan, or render and write
+/// images (no lines for people: [`run`] prints those).
 ///
 /// # Errors
-/// A scene that cannot be loaded or rendered, or [`Error::Mismatch`] listing every render that
-/// differs (the first differing pixel and both values).
+/// As [`RenderJob::prepare`] and [`RenderJob::run`].
+pub fn run_render(args: &RenderArgs) -> Result<RenderReport, Error> {
+    RenderJob::prepare(args)?.run(&Console::QUIET)
+}
+
+/// `raykernel check` without lines for people (see [`run_check_with`]).
+///
+/// # Errors
+/// As [`run_check_with`].
 pub fn run_check(args: &CheckArgs) -> Result<CheckReport, Error> {
+    run_check_with(args, &Console::QUIET)
+}
+
+/// `raykernel check`: every scene (default: every built-in) in each mode, every way of
+/// rendering, byte for byte. Says up front how many renders it will compare, then shows
+/// progress with an estimate of the time left on `console`.
+///
+/// # Errors
+/// A scene that cannot be loaded or rendered, or asks for more than [`crate::limits`]
+/// allows, or [`Error::Mismatch`] listing every render that differs (the first differing
+/// pixel and both values).
+pub fn run_check_with(args: &CheckArgs, console: &Console) -> Result<CheckReport, Error> {
     let names: Vec<String> = if args.scenes.is_empty() {
         scenes::ALL.iter().map(|s| s.name.to_string()).collect()
     } else {
@@ -632,14 +804,39 @@ pub fn run_check(args: &CheckArgs) -> Result<CheckReport, Error> {
         Some(m) => vec![m],
         None => vec![Mode::F32, Mode::Fixed],
     };
-    let mut cases = Vec::new();
+    let mut specs = Vec::with_capacity(names.len());
     for name in &names {
         let mut spec = resolve_scene(name)?;
         spec.settings = args.settings.apply(spec.settings);
         for &mode in &modes {
-            cases.push(check_scene(&spec, mode)?);
+            check_render_request(&spec, mode, false)?;
+        }
+        specs.push(spec);
+    }
+    let per_case = renders_per_case();
+    let total = specs.len() * modes.len() * per_case;
+    let samples: u64 = specs
+        .iter()
+        .map(|s| {
+            u64::from(s.settings.width) * u64::from(s.settings.height) * u64::from(s.settings.spp)
+        })
+        .sum();
+    console.line(&format!(
+        "check: {} scene(s) × {} mode(s), {per_case} renders each (the kernel's reference and \
+         {} ways to match it): {total} renders, {:.1} M samples per mode",
+        specs.len(),
+        modes.len(),
+        per_case - 1,
+        samples as f64 / 1e6
+    ));
+    let mut progress = console.progress("check", "renders", total);
+    let mut cases = Vec::new();
+    for spec in &specs {
+        for &mode in &modes {
+            cases.push(check_scene_with(spec, mode, &mut || progress.step())?);
         }
     }
+    progress.finish();
     let lines = describe_differences(&cases);
     if !lines.is_empty() {
         return Err(Error::Mismatch(format!(
@@ -654,7 +851,7 @@ pub fn run_check(args: &CheckArgs) -> Result<CheckReport, Error> {
     })
 }
 
-/// `host trace`: load the scene and rays, trace, write the hits.
+/// `raykernel trace`: load the scene and rays, trace, write the hits.
 ///
 /// # Errors
 /// Bad or unreadable inputs, an unwritable output, or a build the kernel refuses.
@@ -684,6 +881,14 @@ pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
     let output = trace(&mesh, &args.scene, &rays, &config)?;
     write_hits(&args.out, &output.hits)?;
     let s = output.stats;
+    let first_bad = if s.bad_rays > 0 {
+        match args.mode {
+            Mode::F32 => first_rejected::<f32>(&rays, args.stride),
+            Mode::Fixed => first_rejected::<I16F16>(&rays, args.stride),
+        }
+    } else {
+        None
+    };
     let per_s = |ms: f64| {
         if ms > 0.0 {
             s.rays as f64 / ms / 1e3
@@ -705,16 +910,25 @@ pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
         stride: args.stride,
         triangles: s.triangles,
         build_ms: s.build_ms,
+        per_ray_ms: s.per_ray_ms,
         setup_ms: s.setup_ms,
         trace_ms: s.trace_ms,
         build_ms_runs: s.build_ms_runs,
+        per_ray_ms_runs: s.per_ray_ms_runs,
         trace_ms_runs: s.trace_ms_runs,
         rays: s.rays,
         rays_in_file: rays.len(),
-        mrays_per_s: per_s(s.trace_ms),
-        mrays_per_s_with_setup: per_s(s.trace_ms + s.setup_ms),
+        mrays_per_s: per_s(s.per_ray_ms),
+        mrays_per_s_prebuilt: per_s(s.trace_ms),
+        setup_ns_per_ray: if s.rays > 0 {
+            s.setup_ms * 1e6 / s.rays as f64
+        } else {
+            0.0
+        },
         hits: s.hits,
         bad_rays: s.bad_rays,
+        first_bad_ray: first_bad.map(|(i, _)| i),
+        first_bad_ray_error: first_bad.map(|(_, e)| ray_error_text(e, args.mode.name())),
         nodes: s.nodes,
         bytes_per_tri: if s.triangles > 0 {
             s.accel_bytes as f64 / s.triangles as f64
@@ -725,68 +939,46 @@ pub fn run_trace(args: &TraceArgs) -> Result<TraceReport, Error> {
     })
 }
 
-/// `host bench`: run the benchmark, write the report, data and plots.
-///
-/// # Errors
-/// Missing inputs (the message says how to get them), bad scene or ray files, a build the
-/// kernel refuses, or an unwritable output directory.
-pub fn run_bench(args: &BenchArgs) -> Result<BenchReport, Error> {
-    use crate::bench::{scale::ScaleOptions, workload::RaySource, BenchConfig};
-    let rays = match (&args.rays, args.rust_rays) {
-        (Some(dir), _) => RaySource::Files(dir.clone()),
-        (None, true) => RaySource::Rust {
-            count: args.rays_per_set,
-        },
-        (None, false) => RaySource::MakeRays,
-    };
-    let sizes = match &args.scale {
-        Some(sizes) => sizes.iter().copied().filter(|&n| n > 0).collect(),
-        None => crate::bench::scale::default_sizes(args.quick),
-    };
-    let config = BenchConfig {
-        scenes_dir: args.scenes.clone(),
-        scenes: args.scene_names.clone(),
-        rays,
-        out: args.out.clone(),
-        stride: args.stride.unwrap_or(if args.quick { 64 } else { 1 }),
-        runs: args.runs.unwrap_or(if args.quick { 1 } else { 3 }),
-        peers: !args.no_peers,
-        rounds: args.rounds.unwrap_or(if args.quick { 2 } else { 7 }),
-        scale: ScaleOptions {
-            sizes,
-            rays: args
-                .scale_rays
-                .unwrap_or(if args.quick { 1 << 14 } else { 1 << 18 }),
-            runs: args.runs.unwrap_or(if args.quick { 1 } else { 3 }),
-        },
-        images: (!args.no_images).then(|| {
-            let threads = std::thread::available_parallelism().map_or(1, usize::from);
-            crate::bench::images::ImageOptions::new(args.quick, args.image_spp, threads)
-        }),
-        quick: args.quick,
-        command: bench_command(),
-    };
-    let (results, written) = crate::bench::run(&config)?;
-    let show = |p: &Path| p.display().to_string();
-    Ok(BenchReport {
-        report: show(&written.report),
-        csv: show(&written.csv),
-        json: show(&written.json),
-        plots: written.plots.iter().map(|p| show(p)).collect(),
-        rows: results.rows.len(),
-        scale_rows: results.scale.len(),
-        elapsed_s: results.elapsed_s,
-    })
+/// The first of every `stride`-th record that mode `S` cannot make a ray of: its index in the
+/// file and why.
+fn first_rejected<S: Scalar>(rays: &[RayRecord], stride: usize) -> Option<(usize, RayError)> {
+    rays.iter()
+        .enumerate()
+        .step_by(stride.max(1))
+        .find_map(|(i, r)| {
+            Ray::<S>::from_f32(r.origin, r.dir, r.t_min, r.t_max)
+                .err()
+                .map(|e| (i, e))
+        })
 }
 
-/// The command line as typed, with the program shown as `host`.
-fn bench_command() -> String {
-    let mut words: Vec<String> = std::env::args().skip(1).collect();
-    words.insert(0, "host".into());
-    words.join(" ")
+/// What the kernel's [`RayError`] means in `mode`.
+fn ray_error_text(e: RayError, mode: &str) -> String {
+    match e {
+        RayError::Origin(p) => format!("ray origin: {}", point_error_text(p, mode)),
+        other => other.to_string(),
+    }
 }
 
-/// `host compare-hits`: agreement of OTHER with REF.
+impl TraceReport {
+    /// `3 of 50 rays rejected ... (first: ray 7, ...)`, when the kernel rejected any.
+    #[must_use]
+    pub fn rejected_rays_warning(&self) -> Option<String> {
+        if self.bad_rays == 0 {
+            return None;
+        }
+        let first = match (self.first_bad_ray, &self.first_bad_ray_error) {
+            (Some(i), Some(e)) => format!("; the first is record {i} of {}: {e}", self.rays_file),
+            _ => String::new(),
+        };
+        Some(format!(
+            "{} of {} traced rays rejected in {} mode and written as misses{first}",
+            self.bad_rays, self.rays, self.mode
+        ))
+    }
+}
+
+/// `raykernel compare-hits`: agreement of OTHER with REF.
 ///
 /// # Errors
 /// Unreadable or malformed hit files, or files of different lengths; with `--scene` and

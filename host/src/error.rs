@@ -60,7 +60,7 @@ pub enum Error {
         /// What is wrong, or what was expected.
         msg: String,
     },
-    /// `host check`: two renders that must be byte-identical differ.
+    /// `raykernel check`: two renders that must be byte-identical differ.
     Mismatch(String),
     /// An output could not be encoded or written.
     Output {
@@ -69,8 +69,6 @@ pub enum Error {
         /// Why.
         msg: String,
     },
-    /// `host bench`: a missing input (scenes, ray files, the ray script) or a failed step.
-    Bench(String),
     /// Two hit files to compare hold different numbers of records.
     HitCountMismatch {
         /// The reference file and its record count.
@@ -123,7 +121,6 @@ impl fmt::Display for Error {
             Self::Scene { file, field, msg } if field.is_empty() => write!(f, "{file}: {msg}"),
             Self::Scene { file, field, msg } => write!(f, "{file}: {field}: {msg}"),
             Self::Output { path, msg } => write!(f, "{}: {msg}", path.display()),
-            Self::Bench(msg) => write!(f, "bench: {msg}"),
             Self::HitCountMismatch { reference, other } => write!(
                 f,
                 "hit files differ in length: {} has {} records, {} has {}",
@@ -149,10 +146,75 @@ impl std::error::Error for Error {
             | Self::Scene { .. }
             | Self::Mismatch(_)
             | Self::Output { .. }
-            | Self::Bench(_)
             | Self::HitCountMismatch { .. } => None,
         }
     }
+}
+
+/// Longest line [`for_terminal`] passes through whole, in characters.
+pub const MAX_LINE_CHARS: usize = 400;
+
+/// `text` made safe to print: control characters (other than line breaks) and the byte-order
+/// mark escaped as `\u{..}`, and each line longer than [`MAX_LINE_CHARS`] cut to its start
+/// and end around a note of how much was left out. Messages can quote what a file holds
+/// (an unknown key, a bad token), which may be binary bytes or a string of any length.
+#[must_use]
+pub fn for_terminal(text: &str) -> String {
+    let escape = |c: char| -> String {
+        if (c.is_control() && c != '\t') || c == '\u{feff}' {
+            c.escape_unicode().to_string()
+        } else {
+            c.to_string()
+        }
+    };
+    text.split('\n')
+        .map(|line| {
+            let count = line.chars().count();
+            if count <= MAX_LINE_CHARS {
+                return line.chars().map(escape).collect::<String>();
+            }
+            let (head, tail) = (MAX_LINE_CHARS * 2 / 3, MAX_LINE_CHARS / 4);
+            let start: String = line.chars().take(head).map(escape).collect();
+            let end: String = line.chars().skip(count - tail).map(escape).collect();
+            format!(
+                "{start} [… {} characters left out …] {end}",
+                count - head - tail
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// `text` with every run of more than `max` non-space characters cut to its start and end
+/// around the count left out: keys and values quoted from a file stay readable, however long.
+#[must_use]
+pub fn shorten_long_words(text: &str, max: usize) -> String {
+    let mut out = String::with_capacity(text.len().min(4 * max));
+    let mut word = String::new();
+    let flush = |word: &mut String, out: &mut String| {
+        let count = word.chars().count();
+        if count > max {
+            let head: String = word.chars().take(max / 2).collect();
+            let tail: String = word.chars().skip(count - max / 4).collect();
+            out.push_str(&format!(
+                "{head}[… {} characters …]{tail}",
+                count - max / 2 - max / 4
+            ));
+        } else {
+            out.push_str(word);
+        }
+        word.clear();
+    };
+    for c in text.chars() {
+        if c.is_whitespace() {
+            flush(&mut word, &mut out);
+            out.push(c);
+        } else {
+            word.push(c);
+        }
+    }
+    flush(&mut word, &mut out);
+    out
 }
 
 impl From<ObjError> for Error {
@@ -164,5 +226,32 @@ impl From<ObjError> for Error {
 impl From<FileError> for Error {
     fn from(e: FileError) -> Self {
         Self::File(e)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn terminal_text_escapes_control_bytes_and_cuts_long_lines() {
+        assert_eq!(for_terminal("plain\nlines"), "plain\nlines");
+        assert_eq!(for_terminal("a\u{1b}[2Jb\0"), "a\\u{1b}[2Jb\\u{0}");
+        assert_eq!(for_terminal("\u{feff}x"), "\\u{feff}x");
+        let long = format!("unknown field `{}`, expected `name`", "x".repeat(100_000));
+        let short = for_terminal(&long);
+        assert!(short.chars().count() < MAX_LINE_CHARS + 60, "{short}");
+        assert!(short.starts_with("unknown field `xxx"), "{short}");
+        assert!(short.ends_with("expected `name`"), "{short}");
+        assert!(short.contains("characters left out"), "{short}");
+    }
+
+    #[test]
+    fn long_words_are_cut_in_the_middle() {
+        assert_eq!(shorten_long_words("a bb  ccc", 3), "a bb  ccc");
+        assert_eq!(
+            shorten_long_words("key `abcdefghijkl`, x", 8),
+            "key `abc[… 9 characters …]`, x"
+        );
     }
 }

@@ -1,6 +1,8 @@
-//! Host side of raykernel: OBJ scenes, ray and hit files, and the `host` command line.
+//! Host side of raykernel: OBJ scenes, ray and hit files, and the `raykernel` command line.
 //!
 //! Everything the binary does lives here so it can be tested without spawning it:
+//! - [`input`]: reading input files (regular files only, size-capped),
+//! - [`limits`]: bounds on every resource a file or flag can request, and the memory check,
 //! - [`obj`]: OBJ reader with `file:line` errors,
 //! - [`rayfile`]: ray and hit file records,
 //! - [`trace`]: build an accelerator and trace rays, generic over the kernel's scalar modes,
@@ -13,20 +15,24 @@
 //! - [`render`]: parallel tiles over the kernel's distribution ray tracer, PNG and PFM out,
 //! - [`check`]: every way of rendering gives the same bytes,
 //! - [`snapshot`]: exact comparison with golden images and hashes,
-//! - [`bench`]: `host bench`, speed and accuracy with peers in one run (report, data, plots),
 //! - [`cli`]: the command line (clap) and the commands behind it,
+//! - [`console`]: lines for people (summaries, warnings, progress) apart from the report,
+//! - [`output`]: output files checked and reserved before the work,
 //! - [`error`]: the error type `main` turns into a message and an exit code.
 #![forbid(unsafe_code)]
 
 pub mod bake;
-pub mod bench;
 pub mod check;
 pub mod classify;
 pub mod cli;
 pub mod compare;
+pub mod console;
 pub mod error;
+pub mod input;
+pub mod limits;
 pub mod mesh;
 pub mod obj;
+pub mod output;
 pub mod rayfile;
 pub mod render;
 pub mod scene;

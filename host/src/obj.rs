@@ -7,11 +7,15 @@
 //!
 //! The triangle id used in hit files is the 0-based index of a triangle in this output order.
 //! A positive index may point at a vertex defined later in the file (checked once the whole file
-//! is read); a negative one counts back from the vertices defined so far.
+//! is read); a negative one counts back from the vertices defined so far. A leading UTF-8
+//! byte-order mark is skipped. Files are read only if regular and at most
+//! [`MAX_OBJ_FILE_BYTES`] long; a mesh holds at most [`MAX_TRIANGLES`] triangles.
 //!
 //! [`parse_obj`] never panics, whatever the bytes.
 
-use raykernel::{PointError, Scalar, Triangle};
+use crate::input::{read_limited, InputError};
+use crate::limits::{MAX_OBJ_FILE_BYTES, MAX_TRIANGLES};
+use raykernel::{PointError, Scalar, Triangle, F32_COORD_LIMIT, FIXED_COORD_LIMIT};
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -80,8 +84,8 @@ pub struct ObjError {
 /// What is wrong with an OBJ file.
 #[derive(Debug)]
 pub enum ObjErrorKind {
-    /// The file could not be read.
-    Read(std::io::Error),
+    /// The file could not be read (missing, not a regular file, too large).
+    Read(InputError),
     /// A vertex line does not hold 3, 4 (`x y z w`) or 6 (`x y z r g b`) numbers.
     VertexArity {
         /// Numbers found.
@@ -118,6 +122,11 @@ pub enum ObjErrorKind {
     },
     /// The file holds no face at all.
     NoTriangles,
+    /// The faces so far make more triangles than a mesh may hold.
+    TooManyTriangles {
+        /// The limit, [`MAX_TRIANGLES`].
+        limit: usize,
+    },
     /// A vertex cannot be used in the requested number mode (reported at the vertex's line).
     UnusableVertex {
         /// The first triangle using it.
@@ -175,13 +184,17 @@ impl fmt::Display for ObjErrorKind {
                 write!(f, "face has {count} vertices, at least 3 are needed")
             }
             Self::NoTriangles => write!(f, "no faces: the file holds no triangles"),
+            Self::TooManyTriangles { limit } => {
+                write!(f, "too many triangles: a mesh holds at most {limit}")
+            }
             Self::UnusableVertex {
                 triangle,
                 mode,
                 error,
             } => write!(
                 f,
-                "vertex unusable in {mode} mode (triangle {triangle}): {error}"
+                "vertex unusable in {mode} mode (triangle {triangle}): {}",
+                point_error_text(*error, mode)
             ),
         }
     }
@@ -196,12 +209,36 @@ impl std::error::Error for ObjError {
     }
 }
 
+/// What the kernel's [`PointError`] means in `mode` (`f32` or `fixed`): the range it names is
+/// that mode's, not always the fixed-point one.
+#[must_use]
+pub fn point_error_text(error: PointError, mode: &str) -> String {
+    match error {
+        PointError::OutOfRange { .. } => {
+            format!("coordinate outside {}", coordinate_range(mode))
+        }
+        other => other.to_string(),
+    }
+}
+
+/// `[-8192, 8192], the coordinate range of fixed mode` (or of `f32` mode).
+#[must_use]
+pub fn coordinate_range(mode: &str) -> String {
+    let limit = if mode == "fixed" {
+        FIXED_COORD_LIMIT
+    } else {
+        F32_COORD_LIMIT
+    };
+    format!("[-{limit:.0}, {limit:.0}], the coordinate range of {mode} mode")
+}
+
 /// Reads and parses an OBJ file.
 ///
 /// # Errors
-/// [`ObjErrorKind::Read`] if the file cannot be read, else as [`parse_obj`].
+/// [`ObjErrorKind::Read`] if the file cannot be read, is not a regular file or is larger
+/// than [`MAX_OBJ_FILE_BYTES`], else as [`parse_obj`].
 pub fn load_obj(path: &Path) -> Result<Mesh, ObjError> {
-    let bytes = std::fs::read(path).map_err(|e| ObjError {
+    let bytes = read_limited(path, MAX_OBJ_FILE_BYTES).map_err(|e| ObjError {
         path: path.to_path_buf(),
         line: None,
         kind: ObjErrorKind::Read(e),
@@ -215,6 +252,8 @@ pub fn load_obj(path: &Path) -> Result<Mesh, ObjError> {
 /// The first problem found, with its line.
 pub fn parse_obj(bytes: &[u8], path_for_errors: &Path) -> Result<Mesh, ObjError> {
     let err = |line: usize, kind| ObjError::at(path_for_errors, line, kind);
+    // A byte-order mark is not part of the first statement.
+    let bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
     let mut mesh = Mesh::default();
     let mut face: Vec<u32> = Vec::new();
     let mut line_no = 0usize;
@@ -255,6 +294,14 @@ pub fn parse_obj(bytes: &[u8], path_for_errors: &Path) -> Result<Mesh, ObjError>
                     return Err(err(
                         line_no,
                         ObjErrorKind::TooFewVertices { count: face.len() },
+                    ));
+                }
+                if mesh.triangles.len() + (face.len() - 2) > MAX_TRIANGLES {
+                    return Err(err(
+                        line_no,
+                        ObjErrorKind::TooManyTriangles {
+                            limit: MAX_TRIANGLES,
+                        },
                     ));
                 }
                 for k in 1..face.len() - 1 {

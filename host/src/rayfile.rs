@@ -4,6 +4,8 @@
 //! - Ray: 32 bytes, `ox oy oz dx dy dz tmin tmax`, eight `f32`.
 //! - Hit: 8 bytes, `t: f32, prim: u32`; a miss is `t = +inf, prim = u32::MAX`.
 
+use crate::input::{read_limited, InputError};
+use crate::limits::MAX_RAY_FILE_BYTES;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -114,12 +116,12 @@ impl HitRecord {
 /// A ray or hit file could not be read, written, or has the wrong length.
 #[derive(Debug)]
 pub enum FileError {
-    /// Reading failed.
+    /// Reading failed (missing, not a regular file, larger than [`MAX_RAY_FILE_BYTES`]).
     Read {
         /// The file.
         path: PathBuf,
         /// Why.
-        source: std::io::Error,
+        source: InputError,
     },
     /// Writing failed.
     Write {
@@ -168,14 +170,15 @@ impl fmt::Display for FileError {
 impl std::error::Error for FileError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            Self::Read { source, .. } | Self::Write { source, .. } => Some(source),
+            Self::Read { source, .. } => Some(source),
+            Self::Write { source, .. } => Some(source),
             Self::Length { .. } => None,
         }
     }
 }
 
 fn read(path: &Path) -> Result<Vec<u8>, FileError> {
-    std::fs::read(path).map_err(|source| FileError::Read {
+    read_limited(path, MAX_RAY_FILE_BYTES).map_err(|source| FileError::Read {
         path: path.to_path_buf(),
         source,
     })
@@ -194,7 +197,7 @@ fn records<'b, const N: usize>(
     path: &Path,
     what: &'static str,
 ) -> Result<impl Iterator<Item = &'b [u8; N]>, FileError> {
-    if bytes.len().is_multiple_of(N) {
+    if bytes.len() % N == 0 {
         // Every chunk has N bytes, so the conversion cannot fail.
         Ok(bytes.chunks_exact(N).flat_map(<&[u8; N]>::try_from))
     } else {

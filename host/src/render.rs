@@ -9,13 +9,13 @@ use crate::error::Error;
 use crate::trace::{AccelKind, Mode, NodeArena};
 use indicatif::{ProgressBar, ProgressStyle};
 use raykernel::bvh::BuildOptions;
-use raykernel::geom::spawn::SpawnScalar;
 use raykernel::render::scenes::SceneData;
 use raykernel::render::{
     encode_srgb8, memory_needed, AccelChoice, AccelMemory, Object, ObjectSlot, RenderPlan,
     RenderStats, Renderer, Rgb, SceneError, Settings, Shape, Tile,
 };
-use raykernel::{GridOptions, KdNode, KdOptions, Scalar, Sphere, Triangle, I16F16};
+use raykernel::spawn::SpawnScalar;
+use raykernel::{grid::GridOptions, kdtree::KdOptions, KdNode, Scalar, Sphere, Triangle, I16F16};
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::Path;

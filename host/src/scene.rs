@@ -1,11 +1,14 @@
-//! Scenes for `host render` and `host check`: what the SCENE argument names (a built-in scene,
-//! a scene file, or an OBJ mesh), and the lights, material and camera an OBJ gets: the camera
-//! from its `NAME.camera` file (format of `shared/bench/WORKLOAD.md`) or framed by its box.
+//! Scenes for `raykernel render` and `raykernel check`: what the SCENE argument names (a
+//! built-in scene, a scene file, or an OBJ mesh), and the lights, material and camera an OBJ
+//! gets: the camera from its `NAME.camera` file (format of `shared/bench/WORKLOAD.md`) or
+//! framed by its box.
 
 use crate::error::Error;
+use crate::input::read_text_limited;
+use crate::limits::MAX_CAMERA_FILE_BYTES;
 use crate::obj::load_obj;
 use crate::scenefile::{load_scene_file, DEFAULT_SETTINGS};
-use crate::spec::{ObjectSource, SceneOrigin, SceneSpec};
+use crate::spec::{eye_to_look_at, ObjectSource, SceneOrigin, SceneSpec};
 use raykernel::render::scenes::{self, ObjectData, ShapeRange};
 use raykernel::render::{Camera, Light, Material};
 use std::path::Path;
@@ -55,7 +58,7 @@ pub struct PinholeCamera {
 
 impl PinholeCamera {
     /// Parses `eye x y z`, `target x y z`, `up x y z` and `vfov degrees` lines; `#` starts a
-    /// comment. `path` labels errors.
+    /// comment; a leading byte-order mark is skipped. `path` labels errors.
     ///
     /// # Errors
     /// [`Error::Camera`] naming the line of a bad statement, or a missing or unusable value.
@@ -66,6 +69,7 @@ impl PinholeCamera {
             msg,
         };
         let (mut eye, mut target, mut up, mut vfov) = (None, None, None, None);
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         for (i, raw) in text.lines().enumerate() {
             let line = Some(i + 1);
             let body = raw.split('#').next().unwrap_or_default();
@@ -157,17 +161,18 @@ impl PinholeCamera {
         })
     }
 
-    /// The kernel's camera (pinhole).
+    /// The kernel's camera: a pinhole, focused on the target (for when an aperture is set).
     #[must_use]
     pub fn to_kernel(&self) -> Camera {
         let f = |p: [f64; 3]| p.map(|x| x as f32);
+        let (eye, look_at) = (f(self.eye), f(self.target));
         Camera {
-            eye: f(self.eye),
-            look_at: f(self.target),
+            eye,
+            look_at,
             up: f(self.up),
             vfov_deg: self.vfov_deg as f32,
             aperture_radius: 0.0,
-            focus_distance: 1.0,
+            focus_distance: eye_to_look_at(eye, look_at),
         }
     }
 }
@@ -227,11 +232,12 @@ pub fn obj_scene(path: &Path) -> Result<SceneSpec, Error> {
     let (lo, hi) = bounds(&triangles);
     let camera_path = path.with_extension("camera");
     let camera = if camera_path.is_file() {
-        let text = std::fs::read_to_string(&camera_path).map_err(|e| Error::Camera {
-            path: camera_path.clone(),
-            line: None,
-            msg: format!("cannot read: {e}"),
-        })?;
+        let text =
+            read_text_limited(&camera_path, MAX_CAMERA_FILE_BYTES).map_err(|e| Error::Camera {
+                path: camera_path.clone(),
+                line: None,
+                msg: format!("cannot read: {e}"),
+            })?;
         PinholeCamera::parse(&text, &camera_path)?
     } else {
         PinholeCamera::frame(lo, hi, DEFAULT_SETTINGS.width, DEFAULT_SETTINGS.height)
@@ -264,6 +270,7 @@ pub fn obj_scene(path: &Path) -> Result<SceneSpec, Error> {
         object_sources: vec![ObjectSource::Mesh {
             path: path.to_path_buf(),
             vertex_lines,
+            transform: None,
         }],
         materials: vec![Material::Diffuse { albedo: OBJ_ALBEDO }],
         material_names: vec!["white".into()],

@@ -3,23 +3,34 @@
 //! [`SceneData`] (every built-in scene) into the same format.
 //!
 //! Every struct denies unknown fields, so a misspelt key is an error, not a silent default.
+//! A file is at most [`MAX_SCENE_FILE_BYTES`] of UTF-8 (a leading byte-order mark is
+//! skipped), and its lists are bounded by [`crate::limits`] before any mesh is read.
 //! Errors name the file, the field as a path (`objects[2].spheres[0].radius`, from
 //! `serde_path_to_error`) and what was expected; values the kernel rejects are reported the
 //! same way ([`SceneSpec::explain`]).
 
-use crate::error::Error;
+use crate::error::{shorten_long_words, Error};
+use crate::input::read_text_limited;
+use crate::limits::{
+    check_count, OverLimit, MAX_MATERIALS, MAX_OBJECTS, MAX_SCENE_FILE_BYTES, MAX_SPHERES,
+    MAX_TRIANGLES,
+};
 use crate::obj::load_obj;
-use crate::spec::{ObjectSource, SceneOrigin, SceneSpec};
+use crate::spec::{eye_to_look_at, ObjectSource, SceneOrigin, SceneSpec};
 use raykernel::render::scenes::{ObjectData, SceneData, ShapeRange, SphereData};
+use raykernel::render::MAX_LIGHTS;
 use raykernel::render::{AccelChoice, Camera, Filter, Light, Material, SamplerKind, Settings};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::collections::HashMap;
+use std::path::{Component, Path, PathBuf};
 
 /// The `format` key every scene file starts with.
 pub const FORMAT: &str = "raykernel-scene";
 /// The version this reader reads and the dump writes.
 pub const VERSION: u32 = 1;
+/// Longest word (key, value, token) an error message quotes from a file whole.
+const QUOTE_CHARS: usize = 80;
 
 /// Settings for fields a scene file leaves out (and for OBJ scenes).
 pub const DEFAULT_SETTINGS: Settings = Settings {
@@ -357,7 +368,7 @@ struct Header {
 /// [`Error::Scene`] naming the file, the field and the problem; [`Error::File`] if the file
 /// cannot be read. Meshes that cannot be read or parsed are reported at their `mesh` field.
 pub fn load_scene_file(path: &Path) -> Result<SceneSpec, Error> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::Scene {
+    let text = read_text_limited(path, MAX_SCENE_FILE_BYTES).map_err(|e| Error::Scene {
         file: path.display().to_string(),
         field: String::new(),
         msg: format!("cannot read: {e}"),
@@ -370,11 +381,19 @@ pub fn load_scene_file(path: &Path) -> Result<SceneSpec, Error> {
 /// # Errors
 /// As [`load_scene_file`].
 pub fn parse_scene_file(text: &str, path: &Path) -> Result<SceneSpec, Error> {
+    // Keys and values quoted from the file are cut to a readable length.
     let err = |field: &str, msg: String| Error::Scene {
         file: path.display().to_string(),
-        field: field.to_string(),
-        msg,
+        field: shorten_long_words(field, QUOTE_CHARS),
+        msg: shorten_long_words(&msg, QUOTE_CHARS),
     };
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    if let Some(found) = not_an_object(text) {
+        return Err(err(
+            "",
+            format!("a scene file is one JSON object `{{ ... }}`, but this file holds {found}"),
+        ));
+    }
     let header: Header = serde_json::from_str(text).map_err(|e| err("", e.to_string()))?;
     match header.format {
         Some(Value::String(f)) if f == FORMAT => {}
@@ -405,8 +424,9 @@ pub fn parse_scene_file(text: &str, path: &Path) -> Result<SceneSpec, Error> {
     let file: SceneFile = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         let field = e.path().to_string();
         let field = if field == "." { String::new() } else { field };
-        err(&field, e.into_inner().to_string())
+        err(&field, without_type_names(&e.into_inner().to_string()))
     })?;
+    check_lists(&file).map_err(|e| err(e.field, e.msg))?;
     let stem = path
         .file_stem()
         .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
@@ -415,12 +435,65 @@ pub fn parse_scene_file(text: &str, path: &Path) -> Result<SceneSpec, Error> {
     Ok(spec)
 }
 
-/// Checks `spec` the way the kernel will: builds an `f32` renderer over it with brute force
-/// (no memory needed) and maps any error back to the scene's fields.
+/// What a text that is not a JSON object starts with (`an array`, `a string`, ...), or `None`
+/// for an object (or an empty text, which the JSON reader reports).
+fn not_an_object(text: &str) -> Option<&'static str> {
+    let first = text.trim_start().chars().next()?;
+    Some(match first {
+        '{' => return None,
+        '[' => "an array",
+        '"' => "a string",
+        '-' | '0'..='9' => "a number",
+        't' | 'f' => "a boolean",
+        'n' => "null",
+        _ => "no JSON value",
+    })
+}
+
+/// A reader's message without the Rust type names it may quote (`expected struct
+/// CameraEntry` becomes `expected a JSON object`).
+fn without_type_names(msg: &str) -> String {
+    let mut out = msg.to_string();
+    for (prefix, plain) in [
+        ("expected struct ", "expected a JSON object"),
+        ("expected enum ", "expected a JSON object with one key"),
+    ] {
+        while let Some(at) = out.find(prefix) {
+            let rest = &out[at + prefix.len()..];
+            let end = rest
+                .find(|c: char| !(c.is_alphanumeric() || c == '_'))
+                .unwrap_or(rest.len());
+            out = format!("{}{plain}{}", &out[..at], &rest[end..]);
+        }
+    }
+    out
+}
+
+/// Bounds on the file's lists ([`crate::limits`]), checked before any mesh is read.
+fn check_lists(file: &SceneFile) -> Result<(), OverLimit> {
+    check_count(
+        "materials",
+        "materials",
+        file.materials.len(),
+        MAX_MATERIALS,
+    )?;
+    check_count("objects", "objects", file.objects.len(), MAX_OBJECTS)?;
+    check_count("lights", "lights", file.lights.len(), MAX_LIGHTS)?;
+    let inline = |f: fn(&ObjectEntry) -> usize| file.objects.iter().map(f).sum::<usize>();
+    let triangles = inline(|o| o.triangles.as_ref().map_or(0, Vec::len));
+    check_count("objects", "inline triangles", triangles, MAX_TRIANGLES)?;
+    let spheres = inline(|o| o.spheres.as_ref().map_or(0, Vec::len));
+    check_count("objects", "spheres", spheres, MAX_SPHERES)
+}
+
+/// Checks `spec` the way the kernel will: the camera as in
+/// [`SceneSpec::check_camera`], then an `f32` renderer built over it with brute force (no
+/// memory needed), any error mapped back to the scene's fields.
 ///
 /// # Errors
 /// [`SceneSpec::explain`] of the kernel's error.
 pub fn check_in_kernel(spec: &SceneSpec) -> Result<(), Error> {
+    spec.check_camera("f32")?;
     crate::render::with_renderer::<f32, _>(&spec.data(), spec.settings, AccelChoice::Linear, |_| ())
         .map(|_| ())
         .map_err(|e| spec.explain(&e, "f32"))
@@ -435,9 +508,10 @@ fn resolve(file: SceneFile, path: &Path, stem: &str) -> Result<SceneSpec, Error>
     };
     let mut materials = Vec::with_capacity(file.materials.len());
     let mut names: Vec<String> = Vec::with_capacity(file.materials.len());
+    let mut index_of: HashMap<&str, usize> = HashMap::with_capacity(file.materials.len());
     for (i, m) in file.materials.iter().enumerate() {
         let here = format!("materials[{i}] ({:?})", m.name);
-        if names.contains(&m.name) {
+        if index_of.insert(&m.name, i).is_some() {
             return Err(err(
                 here,
                 "duplicate name: material names must be unique".into(),
@@ -486,13 +560,17 @@ fn resolve(file: SceneFile, path: &Path, stem: &str) -> Result<SceneSpec, Error>
     };
     for (i, o) in file.objects.iter().enumerate() {
         let here = |field: &str| format!("objects[{i}]{field}");
-        let Some(material) = spec.material_names.iter().position(|n| *n == o.material) else {
-            let known = spec
+        let Some(&material) = index_of.get(o.material.as_str()) else {
+            let mut known = spec
                 .material_names
                 .iter()
+                .take(10)
                 .map(|n| format!("{n:?}"))
                 .collect::<Vec<_>>()
                 .join(", ");
+            if spec.material_names.len() > 10 {
+                known.push_str(&format!(", … {} in all", spec.material_names.len()));
+            }
             return Err(err(
                 here(".material"),
                 format!("no material named {:?} (materials: {known})", o.material),
@@ -504,6 +582,13 @@ fn resolve(file: SceneFile, path: &Path, stem: &str) -> Result<SceneSpec, Error>
             (Some(mesh), None, None) => {
                 let obj_path = base.join(mesh);
                 let m = load_obj(&obj_path).map_err(|e| err(here(".mesh"), e.to_string()))?;
+                check_count(
+                    "objects",
+                    "triangles",
+                    spec.triangles.len() + m.triangle_count(),
+                    MAX_TRIANGLES,
+                )
+                .map_err(|e| err(here(".mesh"), e.msg))?;
                 let mut lines = Vec::with_capacity(m.triangle_count());
                 for (t, corners) in m.triangles.iter().enumerate() {
                     spec.triangles
@@ -513,6 +598,7 @@ fn resolve(file: SceneFile, path: &Path, stem: &str) -> Result<SceneSpec, Error>
                 let source = ObjectSource::Mesh {
                     path: obj_path,
                     vertex_lines: lines,
+                    transform: o.transform,
                 };
                 (tri_range(first_tri, spec.triangles.len()), source)
             }
@@ -575,10 +661,9 @@ fn tri_range(first: usize, end: usize) -> ShapeRange {
 }
 
 fn camera(c: &CameraEntry) -> Camera {
-    let focus = c.focus_distance.unwrap_or_else(|| {
-        let d: [f64; 3] = std::array::from_fn(|k| f64::from(c.look_at[k] - c.eye[k]));
-        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() as f32
-    });
+    let focus = c
+        .focus_distance
+        .unwrap_or_else(|| eye_to_look_at(c.eye, c.look_at));
     Camera {
         eye: c.eye,
         look_at: c.look_at,
@@ -773,28 +858,64 @@ pub fn to_scene_file(d: &SceneData<'_>, material_names: &[String]) -> SceneFile 
     }
 }
 
-/// The scene file text of `d` (see [`to_scene_file`]): pretty-printed, with number arrays
-/// (points, colours, triangles) kept on one line, every `f32` written in its shortest
-/// round-trip form.
+/// The scene-file form of `spec`, to be written at `scene_file`: as [`to_scene_file`], except
+/// that an object read from an OBJ file names that file (relative to `scene_file`'s directory)
+/// and its transform instead of listing its triangles.
+#[must_use]
+pub fn spec_to_scene_file(spec: &SceneSpec, scene_file: &Path) -> SceneFile {
+    let mut file = to_scene_file(&spec.data(), &spec.material_names);
+    for (entry, source) in file.objects.iter_mut().zip(&spec.object_sources) {
+        if let ObjectSource::Mesh {
+            path, transform, ..
+        } = source
+        {
+            entry.triangles = None;
+            entry.mesh = Some(relative_path(path, scene_file));
+            entry.transform = *transform;
+        }
+    }
+    file
+}
+
+/// `target` relative to the directory of `scene_file` when both resolve to canonical paths,
+/// else `target` as given.
+fn relative_path(target: &Path, scene_file: &Path) -> String {
+    let dir = scene_file
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let (Ok(target_abs), Ok(dir_abs)) = (target.canonicalize(), dir.canonicalize()) else {
+        return target.display().to_string();
+    };
+    let t: Vec<Component<'_>> = target_abs.components().collect();
+    let d: Vec<Component<'_>> = dir_abs.components().collect();
+    let common = t.iter().zip(&d).take_while(|(a, b)| a == b).count();
+    let mut rel = PathBuf::new();
+    for _ in common..d.len() {
+        rel.push("..");
+    }
+    for c in &t[common..] {
+        rel.push(c);
+    }
+    rel.display().to_string()
+}
+
+/// The scene file text of `d` (see [`to_scene_file`] and [`scene_file_text`]).
 #[must_use]
 pub fn dump(d: &SceneData<'_>, material_names: &[String]) -> String {
+    scene_file_text(&to_scene_file(d, material_names))
+}
+
+/// `file` as text: pretty-printed, with number arrays (points, colours, triangles) kept on
+/// one line, every `f32` written in its shortest round-trip form.
+#[must_use]
+pub fn scene_file_text(file: &SceneFile) -> String {
     // A struct of numbers, strings and options: serialization cannot fail.
-    let value = serde_json::to_value(to_scene_file(d, material_names)).unwrap_or(Value::Null);
+    let value = serde_json::to_value(file).unwrap_or(Value::Null);
     let mut out = String::new();
     pretty(&value, 0, &mut out);
     out.push('\n');
     out
-}
-
-/// Writes `d` as a scene file.
-///
-/// # Errors
-/// [`Error::Output`] if the file cannot be written.
-pub fn write_scene_file(path: &Path, d: &SceneData<'_>, names: &[String]) -> Result<(), Error> {
-    std::fs::write(path, dump(d, names)).map_err(|e| Error::Output {
-        path: PathBuf::from(path),
-        msg: format!("cannot write: {e}"),
-    })
 }
 
 /// True for a number, or an array of numbers, or an array of arrays of numbers.

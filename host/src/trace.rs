@@ -1,10 +1,11 @@
 //! Build an accelerator over a mesh and trace rays through it: the in-memory core of
-//! `host trace` and `host bench`, written once over the kernel's [`Scalar`] and dispatched on
+//! `host trace` and of the benchmark (`raykernel-bench`), written once over the kernel's [`Scalar`] and dispatched on
 //! [`Mode`].
 //!
 //! The pieces are public so the benchmark reuses them rather than copying the loop:
 //! [`build_and_visit`] builds whichever [`AccelKind`] is asked for (timed) and hands it to an
-//! [`AccelVisitor`]; [`prepare_rays`] and [`trace_closest`] are the timed halves of a trace.
+//! [`AccelVisitor`]; [`trace_closest_per_ray`] times queries that construct each ray from its
+//! record, [`prepare_rays`] and [`trace_closest`] the two halves of a trace of pre-built rays.
 //! A new accelerator is a new [`AccelKind`] variant plus one arm in [`build_and_visit`].
 //!
 //! [`AccelKind::Bvh4`] builds the BVH (timed) and collapses it into the 4-wide tree (timed
@@ -17,8 +18,8 @@ use crate::rayfile::{HitRecord, RayRecord};
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
 use raykernel::{
-    kdtree, Accel, Bvh, Bvh4, Grid, GridOptions, KdNode, KdOptions, KdTree, Linear, Node, Node4,
-    Primitive, Ray, Scalar, Triangle, I16F16,
+    grid::GridOptions, kdtree, kdtree::KdOptions, Accel, Bvh, Bvh4, Grid, KdNode, KdTree, Linear,
+    Node, Node4, Primitive, Ray, Scalar, Triangle, I16F16,
 };
 use std::path::Path;
 use std::time::Instant;
@@ -183,20 +184,29 @@ pub trait AccelVisitor<S: Scalar> {
 }
 
 /// Figures of a trace: times are the medians over the runs.
+///
+/// Two timings of the same closest-hit queries: `per_ray_ms` constructs each kernel ray from
+/// its record inside the timed loop (what a caller pays per ray), `trace_ms` traces rays
+/// constructed beforehand (`setup_ms`, timed apart) and so counts traversal alone.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TraceStats {
     /// Triangles in the scene.
     pub triangles: usize,
     /// Median wall time of the build, including the leaf-order permutation (0 for linear).
     pub build_ms: f64,
+    /// Median wall time of constructing every traced ray and tracing it, one record at a
+    /// time, storing the hits.
+    pub per_ray_ms: f64,
     /// Median wall time of turning every traced record into a kernel ray (normalisation,
-    /// reciprocals, shear constants), done before tracing as peers' speedtests do.
+    /// reciprocals, shear constants) ahead of tracing.
     pub setup_ms: f64,
-    /// Median wall time of tracing and storing every traced ray (setup excluded).
+    /// Median wall time of tracing and storing every pre-built ray (setup excluded).
     pub trace_ms: f64,
     /// Build time of each run, in run order.
     pub build_ms_runs: Vec<f64>,
-    /// Trace time of each run, in run order.
+    /// Per-ray time (construction included) of each run, in run order.
+    pub per_ray_ms_runs: Vec<f64>,
+    /// Pre-built trace time of each run, in run order.
     pub trace_ms_runs: Vec<f64>,
     /// Rays traced (after the stride).
     pub rays: usize,
@@ -256,7 +266,7 @@ fn trace_in<S: Scalar>(
     let mut first: Option<Vec<HitRecord>> = None;
     let mut last = None;
     let (mut build_ms_runs, mut trace_ms_runs) = (Vec::new(), Vec::new());
-    let mut setup_ms_runs = Vec::new();
+    let (mut setup_ms_runs, mut per_ray_ms_runs) = (Vec::new(), Vec::new());
     for run in 0..config.runs {
         let (hits, stats) = run_once(&tris, &mut arena, scene, rays, config)?;
         if let Some(first) = &first {
@@ -273,22 +283,26 @@ fn trace_in<S: Scalar>(
         build_ms_runs.push(stats.build_ms);
         trace_ms_runs.push(stats.trace_ms);
         setup_ms_runs.push(stats.setup_ms);
+        per_ray_ms_runs.push(stats.per_ray_ms);
         last = Some((hits, stats));
     }
     let (hits, stats) = last.unwrap_or_default();
     let stats = TraceStats {
         triangles: tris.len(),
         build_ms: median(&build_ms_runs),
+        per_ray_ms: median(&per_ray_ms_runs),
         setup_ms: median(&setup_ms_runs),
         trace_ms: median(&trace_ms_runs),
         build_ms_runs,
+        per_ray_ms_runs,
         trace_ms_runs,
         ..stats
     };
     Ok(TraceOutput { hits, stats })
 }
 
-/// One run: build (timed) and trace (timed, rays prepared anew as part of the run).
+/// One run: build (timed), trace constructing each ray in the loop (timed), then prepare the
+/// rays (timed) and trace them again (timed).
 fn run_once<S: Scalar>(
     tris: &[Triangle<S>],
     arena: &mut NodeArena<S>,
@@ -509,7 +523,7 @@ impl<S: Scalar> NodeArena<S> {
 
     /// The `slots` requested, starting on a 64-byte boundary.
     pub fn slots(&mut self) -> &mut [Node<S>] {
-        let misaligned = !(self.nodes.as_ptr() as usize).is_multiple_of(Self::LINE);
+        let misaligned = (self.nodes.as_ptr() as usize) % Self::LINE != 0;
         let skip = usize::from(misaligned);
         let len = self.nodes.len() - 1;
         &mut self.nodes[skip..skip + len]
@@ -517,22 +531,29 @@ impl<S: Scalar> NodeArena<S> {
 
     /// The BVH slots (as [`NodeArena::slots`]) and the 4-wide nodes, for [`AccelKind::Bvh4`].
     pub fn bvh4_slots(&mut self) -> (&mut [Node<S>], &mut [Node4<S>]) {
-        let misaligned = !(self.nodes.as_ptr() as usize).is_multiple_of(Self::LINE);
+        let misaligned = (self.nodes.as_ptr() as usize) % Self::LINE != 0;
         let skip = usize::from(misaligned);
         let len = self.nodes.len() - 1;
         (&mut self.nodes[skip..skip + len], &mut self.nodes4)
     }
 }
 
-/// Traces every `stride`-th ray; fills in the ray, hit and timing figures.
+/// Traces every `stride`-th ray both ways (constructed in the loop, then pre-built); fills in
+/// the ray, hit and timing figures. Both ways give the same hits.
 fn trace_rays<S: Scalar, A: Accel<S>>(
     accel: &A,
     rays: &[RayRecord],
     stride: usize,
 ) -> (Vec<HitRecord>, TraceStats) {
+    let (per_ray_hits, per_ray_ms) = trace_closest_per_ray(accel, rays, stride);
     let prepared = prepare_rays::<S>(rays, stride);
     let (hits, trace_ms) = trace_closest(accel, &prepared);
+    debug_assert!(
+        first_difference(&hits, &per_ray_hits).is_none(),
+        "per-ray and pre-built rays must give the same hits"
+    );
     let stats = TraceStats {
+        per_ray_ms,
         setup_ms: prepared.setup_ms,
         trace_ms,
         rays: hits.len(),
@@ -541,6 +562,58 @@ fn trace_rays<S: Scalar, A: Accel<S>>(
         ..TraceStats::default()
     };
     (hits, stats)
+}
+
+/// Closest hit of every `stride`-th record, each kernel ray constructed from the record's raw
+/// origin, direction and interval inside the timed loop: what a caller pays per query. A
+/// record the kernel rejects is a miss. Returns the hits and the loop's wall time, ms.
+///
+/// # Panics
+/// If `stride` is 0.
+#[must_use]
+pub fn trace_closest_per_ray<S: Scalar, A: Accel<S>>(
+    accel: &A,
+    rays: &[RayRecord],
+    stride: usize,
+) -> (Vec<HitRecord>, f64) {
+    assert!(stride > 0, "stride must be at least 1");
+    let mut hits = vec![HitRecord::MISS; rays.len().div_ceil(stride)];
+    let start = Instant::now();
+    for (slot, r) in hits.iter_mut().zip(rays.iter().step_by(stride)) {
+        let Ok(ray) = Ray::<S>::from_f32(r.origin, r.dir, r.t_min, r.t_max) else {
+            continue;
+        };
+        if let Some(h) = accel.nearest(&ray) {
+            *slot = HitRecord {
+                t: h.t.to_f32(),
+                prim: h.prim,
+            };
+        }
+    }
+    (hits, millis(start))
+}
+
+/// Any hit (occlusion) of every `stride`-th record, each kernel ray constructed inside the
+/// timed loop as in [`trace_closest_per_ray`]. Returns how many are occluded and the loop's
+/// wall time, ms.
+///
+/// # Panics
+/// If `stride` is 0.
+#[must_use]
+pub fn occluded_per_ray<S: Scalar, A: Accel<S>>(
+    accel: &A,
+    rays: &[RayRecord],
+    stride: usize,
+) -> (usize, f64) {
+    assert!(stride > 0, "stride must be at least 1");
+    let start = Instant::now();
+    let mut occluded = 0usize;
+    for r in rays.iter().step_by(stride) {
+        if let Ok(ray) = Ray::<S>::from_f32(r.origin, r.dir, r.t_min, r.t_max) {
+            occluded += usize::from(accel.occluded(&ray));
+        }
+    }
+    (std::hint::black_box(occluded), millis(start))
 }
 
 /// Kernel rays made from ray-file records, one per traced record.

@@ -28,7 +28,7 @@ fn every_built_in_scene_renders_identically_every_way_in_both_modes() {
 
 #[test]
 fn check_command_exits_zero_and_prints_a_json_summary() {
-    let out = Command::new(env!("CARGO_BIN_EXE_host"))
+    let out = Command::new(env!("CARGO_BIN_EXE_raykernel"))
         .args(["check", "spheres", "--mode", "fixed", "--spp", "2"])
         .output()
         .unwrap();
@@ -38,7 +38,14 @@ fn check_command_exits_zero_and_prints_a_json_summary() {
         String::from_utf8_lossy(&out.stderr)
     );
     let stdout = String::from_utf8(out.stdout).unwrap();
-    assert!(stdout.starts_with("check passed: "), "{stdout}");
+    assert!(
+        stdout.starts_with("check: 1 scene(s) × 1 mode(s)"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.lines().any(|l| l.starts_with("check passed: ")),
+        "{stdout}"
+    );
     let v: serde_json::Value = serde_json::from_str(stdout.lines().last().unwrap()).unwrap();
     assert_eq!(v["differences"], 0);
     assert_eq!(v["cases"][0]["scene"], "spheres");

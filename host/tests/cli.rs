@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn host(args: &[&Path]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_host"))
+    Command::new(env!("CARGO_BIN_EXE_raykernel"))
         .args(args)
         .output()
         .expect("run the host binary")
@@ -83,6 +83,9 @@ fn trace_prints_a_json_report_as_the_last_line() {
         "trace_ms",
         "rays",
         "mrays_per_s",
+        "per_ray_ms",
+        "mrays_per_s_prebuilt",
+        "setup_ns_per_ray",
         "hits",
         "bad_rays",
         "nodes",
@@ -91,7 +94,7 @@ fn trace_prints_a_json_report_as_the_last_line() {
     ] {
         assert!(v.get(key).is_some(), "{key} missing from {last}");
     }
-    assert_eq!(v["accel"], "bvh");
+    assert_eq!(v["accel"], "bvh4");
     assert_eq!(v["builder"], "sah");
     assert_eq!(v["mode"], "fixed");
     assert_eq!(v["triangles"], 80);
@@ -210,7 +213,7 @@ fn bad_arguments_are_usage_errors() {
     assert_fails(
         &host(&[&p("render"), &p("--accel"), &p("bvh4"), &p("--out"), &hits]),
         2,
-        "--accel bvh4 is for `host trace` only",
+        "--accel bvh4 is for `raykernel trace` only",
     );
 }
 
@@ -279,7 +282,10 @@ fn compare_hits_classifies_fixed_vs_f32_differences() {
     let count = |k: &str| v[k].as_u64().unwrap_or_else(|| panic!("{k} in {v}"));
     assert_eq!(
         count("differing"),
-        count("explained_by_quantization") + count("explained_by_depth") + count("unexplained"),
+        count("explained_by_quantization")
+            + count("explained_by_depth")
+            + count("explained_by_origin")
+            + count("unexplained"),
         "{v}"
     );
     assert_eq!(count("unexplained"), 0, "{v}");
@@ -347,4 +353,218 @@ fn compare_hits_classifies_fixed_vs_f32_differences() {
         1,
         "hits triangle 99999, but the scene has 1280 triangles",
     );
+}
+
+fn render_args(args: &[&str]) -> host::cli::RenderArgs {
+    use clap::Parser;
+    let mut all = vec!["raykernel", "render"];
+    all.extend(args);
+    match host::cli::Cli::try_parse_from(all).unwrap().command {
+        host::cli::Command::Render(a) => a,
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn width_or_height_alone_keeps_every_built_in_scene_aspect_ratio() {
+    for scene in raykernel::render::scenes::ALL {
+        let (w0, h0) = (scene.settings.width, scene.settings.height);
+        for side in [97u32, 256, 1024] {
+            let round = |a: u32, num: u32, den: u32| {
+                ((u64::from(a) * u64::from(num) + u64::from(den) / 2) / u64::from(den)) as u32
+            };
+            let s = side.to_string();
+            let by_width = render_args(&[scene.name, "--explain", "--width", &s]);
+            let r = host::cli::run_render(&by_width).unwrap();
+            assert_eq!(
+                (r.width, r.height),
+                (side, round(side, h0, w0)),
+                "{}",
+                scene.name
+            );
+            let by_height = render_args(&[scene.name, "--explain", "--height", &s]);
+            let r = host::cli::run_render(&by_height).unwrap();
+            assert_eq!(
+                (r.width, r.height),
+                (round(side, w0, h0), side),
+                "{}",
+                scene.name
+            );
+        }
+    }
+}
+
+#[test]
+fn out_into_a_missing_directory_fails_before_rendering() {
+    let dir = temp_dir("cli_out_missing");
+    let png = dir.join("no/such/dir/pic.png");
+    let start = std::time::Instant::now();
+    // Minutes of work if it started rendering.
+    let out = Command::new(env!("CARGO_BIN_EXE_raykernel"))
+        .args(["render", "--width", "4096", "--spp", "4096", "--out"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    let took = start.elapsed();
+    assert_fails(&out, 1, "cannot write: the directory");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("does not exist"));
+    assert!(took < std::time::Duration::from_secs(1), "took {took:?}");
+}
+
+#[test]
+fn out_must_name_a_png_and_linear_a_pfm() {
+    let dir = temp_dir("cli_out_ext");
+    let jpg = dir.join("pic.jpg");
+    let out = host(&[&p("render"), &p("--out"), &jpg]);
+    assert_fails(&out, 2, "pic.jpg: `.jpg`, but it writes a PNG image");
+    assert!(!jpg.exists());
+    let png = dir.join("pic.png");
+    let exr = dir.join("pic.exr");
+    let out = host(&[&p("render"), &p("--out"), &png, &p("--linear"), &exr]);
+    assert_fails(&out, 2, "--linear");
+    assert!(!png.exists(), "the reserved PNG is removed again");
+}
+
+#[test]
+fn the_plan_line_prints_before_the_render() {
+    use std::io::{BufRead, BufReader};
+    let dir = temp_dir("cli_plan_first");
+    let png = dir.join("slow.png");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_raykernel"))
+        .args([
+            "render",
+            "--width",
+            "1024",
+            "--spp",
+            "1024",
+            "--threads",
+            "1",
+            "--out",
+        ])
+        .arg(&png)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    let still_running = child.try_wait().unwrap().is_none();
+    child.kill().unwrap();
+    let _ = child.wait();
+    assert!(first.starts_with("plan: anti-aliasing on"), "{first}");
+    assert!(still_running, "the plan came only after the render");
+}
+
+#[test]
+fn quiet_prints_only_the_json_report() {
+    for flags in [vec!["--quiet", "render"], vec!["render", "-q"]] {
+        let mut args = flags.clone();
+        args.extend(["spheres", "--explain"]);
+        let out = Command::new(env!("CARGO_BIN_EXE_raykernel"))
+            .args(&args)
+            .output()
+            .unwrap();
+        assert!(out.status.success());
+        let stdout = String::from_utf8(out.stdout).unwrap();
+        assert_eq!(stdout.lines().count(), 1, "{stdout}");
+        let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+        assert_eq!(v["scene"], "spheres");
+    }
+}
+
+#[test]
+fn completions_are_generated_for_the_raykernel_binary() {
+    let out = host(&[&p("completions"), &p("bash")]);
+    assert!(out.status.success());
+    let script = String::from_utf8(out.stdout).unwrap();
+    assert!(script.contains("_raykernel()"), "{script}");
+    assert!(
+        script.contains("--look-at"),
+        "render's camera flags are completed"
+    );
+    assert_fails(&host(&[&p("completions"), &p("tcsh")]), 2, "invalid value");
+}
+
+#[test]
+fn fixed_mode_trace_reports_the_rays_it_rejected() {
+    let (dir, obj, _) = fixture("cli_rejected");
+    let mut rays = random_rays(&mut Rng::new(5), [-2.0; 3], [2.0; 3], 20);
+    rays[3].origin = [9000.0, 0.0, 0.0];
+    rays[11].origin = [0.0, -1e6, 0.0];
+    let path = dir.join("far.rays");
+    write_rays(&path, &rays).unwrap();
+    let hits = dir.join("far.hits");
+    let out = host(&[
+        &p("trace"),
+        &obj,
+        &path,
+        &p("--out"),
+        &hits,
+        &p("--mode"),
+        &p("fixed"),
+    ]);
+    assert!(out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.starts_with(
+            "warning: 2 of 20 traced rays rejected in fixed mode and written as misses; the \
+             first is record 3 of "
+        ),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains(
+            "ray origin: coordinate outside [-8192, 8192], the coordinate range of fixed mode"
+        ),
+        "{stderr}"
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let v: serde_json::Value = serde_json::from_str(stdout.lines().last().unwrap()).unwrap();
+    assert_eq!(
+        (v["bad_rays"].as_u64(), v["first_bad_ray"].as_u64()),
+        (Some(2), Some(3))
+    );
+    // Nothing to report in f32 mode.
+    let out = host(&[&p("trace"), &obj, &path, &p("--out"), &hits]);
+    assert!(out.status.success() && out.stderr.is_empty());
+}
+
+#[test]
+fn binary_bytes_in_an_obj_are_escaped_in_the_message() {
+    let (dir, _, rays) = fixture("cli_binary_obj");
+    let obj = dir.join("binary.obj");
+    std::fs::write(&obj, b"v 1 2 \x1b[2J\x07\nf 1 2 3\n").unwrap();
+    let out = host(&[&p("trace"), &obj, &rays, &p("--out"), &dir.join("x.hits")]);
+    assert_fails(&out, 1, "binary.obj:1: malformed number `\\u{1b}[2J\\u{7}`");
+    assert!(!out.stderr.contains(&0x1b) && !out.stderr.contains(&0x07));
+}
+
+#[test]
+fn check_says_up_front_how_many_renders_it_compares() {
+    let out = Command::new(env!("CARGO_BIN_EXE_raykernel"))
+        .args([
+            "check", "spheres", "--mode", "fixed", "--spp", "1", "--width", "8",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = stdout.lines().collect();
+    let per_case = host::check::renders_per_case();
+    assert_eq!(
+        lines[0],
+        format!(
+            "check: 1 scene(s) × 1 mode(s), {per_case} renders each (the kernel's reference \
+             and {} ways to match it): {per_case} renders, 0.0 M samples per mode",
+            per_case - 1
+        )
+    );
+    let v: serde_json::Value = serde_json::from_str(lines.last().unwrap()).unwrap();
+    assert_eq!(v["renders"].as_u64(), Some(per_case as u64 - 1));
 }

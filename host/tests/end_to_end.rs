@@ -290,9 +290,20 @@ fn several_runs_report_medians_and_write_the_same_hits() {
         assert_eq!(report.trace_ms_runs.len(), 3);
         assert_eq!(report.trace_ms, host::trace::median(&report.trace_ms_runs));
         assert_eq!(report.build_ms, host::trace::median(&report.build_ms_runs));
-        let want = report.rays as f64 / (report.trace_ms / 1e3) / 1e6;
+        assert_eq!(report.per_ray_ms_runs.len(), 3);
+        assert_eq!(
+            report.per_ray_ms,
+            host::trace::median(&report.per_ray_ms_runs)
+        );
+        // The headline counts ray construction; the pre-built figure does not.
+        let per_s = |ms: f64| report.rays as f64 / (ms / 1e3) / 1e6;
+        let (want, prebuilt) = (per_s(report.per_ray_ms), per_s(report.trace_ms));
         assert!(
             (report.mrays_per_s - want).abs() <= 1e-9 * want,
+            "{report:?}"
+        );
+        assert!(
+            (report.mrays_per_s_prebuilt - prebuilt).abs() <= 1e-9 * prebuilt,
             "{report:?}"
         );
     }

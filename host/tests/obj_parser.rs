@@ -357,3 +357,35 @@ fn arbitrary_bytes_never_panic() {
         check(&m);
     }
 }
+
+#[test]
+fn a_byte_order_mark_changes_nothing() {
+    for text in [
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf -1 -2 -3\n",
+    ] {
+        let with = mesh(&format!("\u{feff}{text}"));
+        assert_eq!(with, mesh(text));
+        assert_eq!(with.positions[0], [0.0, 0.0, 0.0]);
+    }
+    let dir = temp_dir("obj_bom");
+    let path = dir.join("bom.obj");
+    std::fs::write(&path, b"\xef\xbb\xbfv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    assert_eq!(load_obj(&path).unwrap().triangle_count(), 1);
+}
+
+#[test]
+fn special_files_are_refused_before_reading() {
+    let e = load_obj(Path::new("/dev/zero")).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "/dev/zero: cannot read OBJ file: is a device, not a regular file"
+    );
+    let dir = temp_dir("obj_special");
+    let e = load_obj(&dir).unwrap_err();
+    assert!(
+        e.to_string()
+            .ends_with("is a directory, not a regular file"),
+        "{e}"
+    );
+}

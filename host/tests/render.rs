@@ -5,7 +5,7 @@
 mod common;
 
 use common::{icosphere, temp_dir};
-use host::cli::{run_render, RenderArgs, SettingsArgs};
+use host::cli::{run_render, CameraArgs, RenderArgs, SettingsArgs};
 use host::render::{decode_png, render, RenderOptions};
 use host::trace::{AccelKind, Builder, Mode};
 use raykernel::render::scenes;
@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn host(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_host"))
+    Command::new(env!("CARGO_BIN_EXE_raykernel"))
         .args(args)
         .output()
         .unwrap()
@@ -44,6 +44,7 @@ fn small(scene: Option<PathBuf>, out: PathBuf, mode: Mode) -> RenderArgs {
             spp: Some(2),
             ..SettingsArgs::default()
         },
+        camera: CameraArgs::default(),
         mode,
         threads: Some(2),
         accel: AccelKind::Bvh,

@@ -30,26 +30,67 @@
 //! assert_eq!((hit.t, hit.prim), (5.0, 0));
 //! ```
 #![no_std]
-// The one exception: SSE intrinsics in `scalar/lanes.rs` (see there).
+// The one exception: SSE and NEON intrinsics in `scalar/lanes.rs` (see there).
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
-pub mod accel;
-pub mod error;
-pub mod geom;
+mod accel;
+mod geom;
 pub mod render;
-pub mod scalar;
+mod scalar;
 
-pub use accel::baked::{self, BakeError, Baked};
-pub use accel::bvh::{self, Bvh, Node};
-pub use accel::bvh4::{self, Bvh4, Node4};
-pub use accel::grid::{self, Grid, GridOptions};
-pub use accel::kdtree::{self, KdNode, KdOptions, KdTree};
-pub use accel::{Accel, Counters, Linear, Nearest, NoStats, TraversalStats};
-pub use error::{Arena, BuildError, PointError, RayError};
+/// The number layer's errors under the path the mode files use.
+mod error {
+    pub(crate) use crate::scalar::{PointError, RayError};
+}
+
+pub use accel::baked::{BakeError, Baked};
+pub use accel::bvh::{Bvh, Node};
+pub use accel::bvh4::{Bvh4, Node4};
+pub use accel::grid::Grid;
+pub use accel::kdtree::{KdNode, KdTree};
+pub use accel::{Accel, Arena, BuildError, Counters, Linear, Nearest, NoStats, TraversalStats};
 pub use geom::{spawn, Aabb, Hit, Primitive, Ray, Sphere, Triangle};
 pub use glam;
-pub use scalar::{Scalar, Vec3x, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16};
+pub use scalar::{PointError, RayError, Scalar, Vec3x, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16};
+
+/// Settings, memory sizes and limits of the binary BVH, [`Bvh`].
+pub mod bvh {
+    pub use crate::accel::bvh::{
+        nodes_needed, BuildOptions, BuilderKind, InvalidTree, RefitError, TreeShape, TreeStats,
+        DEFAULT_LEAF_SIZE, MAX_DEPTH, MAX_LEAF_SIZE, MEDIAN_FALLBACK_DEPTH,
+    };
+}
+
+/// The baked format: a built BVH or 4-wide BVH with its primitives as bytes, and its loader.
+pub mod baked {
+    pub use crate::accel::baked::{
+        bake_bvh, bake_bvh4, baked_len, checksum, load_bvh, load_bvh4, read_header, BakedKind,
+        BakedMode, BakedScalar, Header, FLAG_LEAF_ORDER, HEADER_LEN, MAGIC, MAX_ALIGN,
+        TRIANGLE_LEN, VERSION,
+    };
+}
+
+/// Memory size of the 4-wide BVH, [`Bvh4`].
+pub mod bvh4 {
+    pub use crate::accel::bvh4::nodes4_needed;
+}
+
+/// Settings, memory sizes and limits of the uniform grid, [`Grid`].
+pub mod grid {
+    pub use crate::accel::grid::{
+        GridOptions, GridSize, GridStats, InvalidGrid, DEFAULT_DENSITY, MAILBOX, MAX_DENSITY,
+        MAX_RES,
+    };
+}
+
+/// Settings, memory sizes and limits of the kd-tree, [`KdTree`].
+pub mod kdtree {
+    pub use crate::accel::kdtree::{
+        nodes_needed, refs_needed, InvalidKdTree, KdOptions, KdStats, MAX_DEPTH, NODES_PER_PRIM,
+        REFS_PER_PRIM,
+    };
+}
 
 /// The README's Rust examples, compiled and run as doctests.
 #[cfg(doctest)]

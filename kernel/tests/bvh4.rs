@@ -13,7 +13,7 @@ mod common;
 use common::{c, query, same_hit, with_bvh, with_bvh4, RaySpec, Rng, TestScalar, LEAF_SIZES};
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
-use raykernel::error::Arena;
+use raykernel::Arena;
 use raykernel::{Accel, BuildError, Bvh, Bvh4, Linear, Node, Node4, Ray, Scalar, Triangle, I16F16};
 
 fn tri<S: TestScalar>(v: [[f32; 3]; 3]) -> Triangle<S> {

@@ -11,7 +11,7 @@ use common::{all_options, c, p, query, same_hit, with_bvh, RaySpec, Rng, TestSca
 use raykernel::bvh::{
     nodes_needed, BuildOptions, BuilderKind, MAX_DEPTH, MAX_LEAF_SIZE, MEDIAN_FALLBACK_DEPTH,
 };
-use raykernel::error::Arena;
+use raykernel::Arena;
 use raykernel::{
     Accel, BuildError, Bvh, Linear, Node, PointError, Ray, RayError, Sphere, Triangle,
     F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16,

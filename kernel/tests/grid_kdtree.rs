@@ -9,12 +9,12 @@
 mod common;
 
 use common::{c, p, query, same_hit, with_grid, with_kdtree, RaySpec, Rng, TestScalar};
-use raykernel::error::Arena;
 use raykernel::grid::{GridSize, MAX_DENSITY};
 use raykernel::kdtree::{nodes_needed, refs_needed, MAX_DEPTH};
+use raykernel::Arena;
 use raykernel::{
-    Accel, BuildError, Grid, GridOptions, KdNode, KdOptions, KdTree, Linear, Primitive, Ray,
-    Sphere, Triangle, I16F16,
+    grid::GridOptions, kdtree::KdOptions, Accel, BuildError, Grid, KdNode, KdTree, Linear,
+    Primitive, Ray, Sphere, Triangle, I16F16,
 };
 
 fn tri<S: TestScalar>(v: [[f32; 3]; 3]) -> Triangle<S> {

@@ -26,7 +26,9 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config as ProptestConfig, RngSeed};
 use raykernel::bvh::BuildOptions;
 use raykernel::bvh4::nodes4_needed;
-use raykernel::{Accel, GridOptions, KdOptions, Linear, Primitive, Sphere, Triangle, I16F16};
+use raykernel::{
+    grid::GridOptions, kdtree::KdOptions, Accel, Linear, Primitive, Sphere, Triangle, I16F16,
+};
 
 const SEED: u64 = 0x5eed_7a11_0001;
 /// Cases per property (each case: 2 modes × 3 builders × 4 leaf sizes × RAYS_PER_CASE rays).

@@ -3,7 +3,6 @@
 //! order independence, the render plan, and every typed scene error.
 
 use raykernel::bvh::{BuildOptions, BuilderKind};
-use raykernel::geom::spawn::SpawnScalar;
 use raykernel::render::sampling::{
     concentric_disk, cosine_hemisphere, owen_scramble, permute, phong_lobe, sobol_0, sobol_1, tent,
     to_world, uniform_cone, SampleStream,
@@ -14,7 +13,8 @@ use raykernel::render::{
     Object, ObjectSlot, Problem, Renderer, SamplerKind, Scene, SceneError, Settings, Shape, Tile,
     MAX_LIGHTS,
 };
-use raykernel::{GridOptions, KdNode, KdOptions, Node, Sphere, Triangle, I16F16};
+use raykernel::spawn::SpawnScalar;
+use raykernel::{grid::GridOptions, kdtree::KdOptions, KdNode, Node, Sphere, Triangle, I16F16};
 use std::f64::consts::PI;
 
 /// Renders `scene` into linear RGB with a BVH (or brute force).

@@ -15,8 +15,9 @@ use common::{Rng, TestScalar};
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::spawn::{offset_origin, spawn_ray, spawn_shadow_ray, SpawnScalar};
 use raykernel::{
-    kdtree, Aabb, Accel, Arena, BuildError, Bvh, Grid, GridOptions, Hit, KdNode, KdOptions, KdTree,
-    Linear, Node, PointError, Primitive, Ray, RayError, Scalar, Triangle, Vec3x, I16F16,
+    grid::GridOptions, kdtree, kdtree::KdOptions, Aabb, Accel, Arena, BuildError, Bvh, Grid, Hit,
+    KdNode, KdTree, Linear, Node, PointError, Primitive, Ray, RayError, Scalar, Triangle, Vec3x,
+    I16F16,
 };
 use std::collections::{BTreeMap, HashMap};
 use std::panic::{catch_unwind, AssertUnwindSafe};

@@ -229,11 +229,11 @@ fn leak_report<S: TestScalar>(
         note(accel, rays.len(), leaks);
     }
     // The uniform grid and the kd-tree, default options (built and validated by the helpers).
-    let leaks = with_grid::<S, _, _>(tris, raykernel::GridOptions::default(), |g| {
+    let leaks = with_grid::<S, _, _>(tris, raykernel::grid::GridOptions::default(), |g| {
         count_leaks(g, rays)
     });
     note("grid".into(), rays.len(), leaks);
-    let leaks = with_kdtree::<S, _, _>(tris, raykernel::KdOptions::default(), |k| {
+    let leaks = with_kdtree::<S, _, _>(tris, raykernel::kdtree::KdOptions::default(), |k| {
         count_leaks(k, rays)
     });
     note("kd-tree".into(), rays.len(), leaks);

@@ -9,9 +9,9 @@
 #![allow(dead_code)]
 
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
-use raykernel::geom::spawn::SpawnScalar;
 use raykernel::render::scenes::{self, SceneData};
 use raykernel::render::{AccelChoice, AccelMemory, Object, ObjectSlot, Renderer, Shape, Tile};
+use raykernel::spawn::SpawnScalar;
 use raykernel::{Accel, Bvh, Hit, Linear, Node, Primitive, Ray, Scalar, Sphere, Triangle, I16F16};
 
 /// Triangles of the level-1 icosphere.

@@ -5,8 +5,15 @@
 //!   link check; prints a per-target summary and a final `N passed, M failed` line.
 //! - `cargo xtask panic-check`: only the panic-freedom link check (release, all three targets);
 //!   on failure, lists the kernel source lines that still reach a panic.
-//! - `cargo xtask size`: the footprint table of the README (code size of a build + traverse
-//!   probe, arena bytes per triangle, stack high-water marks measured on target).
+//! - `cargo xtask size`: the footprint of the size probes on the three thumb targets (`.text`,
+//!   `.rodata`, stack measured on target; see `size.rs`), arena bytes per triangle; the last
+//!   stdout line is one JSON object.
+//! - `cargo xtask determinism`: the golden hashes on every architecture (x86_64, aarch64 under
+//!   qemu-aarch64, wasm32 under Node.js's WASI, RISC-V and the three Cortex-M cores under QEMU)
+//!   and hit files compared with x86_64's; writes the table of docs/PLATFORMS.md
+//!   (`determinism.rs`).
+//! - `cargo xtask speed`: instructions per ray and per pixel on the emulated cores; writes the
+//!   table of docs/PLATFORMS.md (`speed.rs`).
 //! - `cargo xtask bless`: rewrites the goldens: the hash file `tests/golden/kernel_hashes.txt`
 //!   (the kernel's golden test), then the snapshot PNGs `tests/golden/images/` (the host's
 //!   snapshot test, which also checks its renders against the new hashes).
@@ -17,9 +24,11 @@
 #[path = "../../tests/golden/cases.rs"]
 #[allow(dead_code, clippy::all)]
 mod cases;
+mod determinism;
+mod platforms;
+mod size;
+mod speed;
 
-use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
-use raykernel::{Bvh, Node, Triangle};
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
 
@@ -64,10 +73,14 @@ fn main() -> ExitCode {
             println!("{} passed, {} failed", r.0, r.1);
             r.1 == 0
         }
-        Some("size") => size(),
+        Some("size") => size::size(),
+        Some("determinism") => determinism::determinism(),
+        Some("speed") => speed::speed(),
         Some("bless") => bless(),
         _ => {
-            eprintln!("usage: cargo xtask <qemu | panic-check | size | bless>");
+            eprintln!(
+                "usage: cargo xtask <qemu | panic-check | size | determinism | speed | bless>"
+            );
             false
         }
     };
@@ -387,170 +400,6 @@ fn panic_sites(elf: &Path) -> Vec<String> {
     }
     sites.sort();
     sites
-}
-
-/// `(.text, .rodata)` of an ELF, from `arm-none-eabi-size -A`.
-fn sections(elf: &Path) -> Option<(u64, u64)> {
-    let out = Command::new("arm-none-eabi-size")
-        .arg("-A")
-        .arg(elf)
-        .output()
-        .ok()?;
-    let text = String::from_utf8_lossy(&out.stdout);
-    let get = |name: &str| {
-        text.lines()
-            .find(|l| l.split_whitespace().next() == Some(name))
-            .and_then(|l| l.split_whitespace().nth(1)?.parse().ok())
-    };
-    Some((get(".text")?, get(".rodata")?))
-}
-
-/// `.text` bytes of an ELF by origin: compiler builtins (soft-float, memcpy), libm, the rest
-/// (kernel code inlined into the probe, startup), from `arm-none-eabi-nm -S`.
-fn breakdown(elf: &Path) -> Option<(u64, u64, u64)> {
-    let out = Command::new("arm-none-eabi-nm")
-        .args(["-C", "-S"])
-        .arg(elf)
-        .output()
-        .ok()?;
-    let (mut builtins, mut libm, mut rest) = (0, 0, 0);
-    for line in String::from_utf8_lossy(&out.stdout).lines() {
-        let f: Vec<&str> = line.splitn(4, ' ').collect();
-        let [_, size, kind, name] = f[..] else {
-            continue;
-        };
-        if !kind.eq_ignore_ascii_case("t") {
-            continue;
-        }
-        let size = u64::from_str_radix(size, 16).ok()?;
-        if name.starts_with("compiler_builtins") || name.starts_with("__aeabi") {
-            builtins += size;
-        } else if name.starts_with("libm") {
-            libm += size;
-        } else {
-            rest += size;
-        }
-    }
-    Some((builtins, libm, rest))
-}
-
-/// Arena bytes (nodes in use + primitive ids) per triangle for each builder, leaves of up to 4.
-fn arena_per_tri(tris: &[Triangle<f32>]) -> Vec<(BuilderKind, f64)> {
-    let mut out = Vec::new();
-    for builder in BuilderKind::ALL {
-        let mut nodes = vec![Node::<f32>::EMPTY; nodes_needed(tris.len())];
-        let mut ids = vec![0u32; tris.len()];
-        let options = BuildOptions {
-            builder,
-            max_leaf_size: 4,
-            reinsertion: true,
-        };
-        if let Ok(bvh) = Bvh::build(tris, &mut nodes, &mut ids, options) {
-            out.push((builder, bvh.bytes_used() as f64 / tris.len() as f64));
-        }
-    }
-    out
-}
-
-/// A 64×64 heightfield (8192 triangles) of a smooth bump: a larger generated mesh.
-fn heightfield() -> Vec<Triangle<f32>> {
-    const N: usize = 64;
-    let h = |i: usize, j: usize| {
-        let (x, y) = (i as f32 / N as f32 - 0.5, j as f32 / N as f32 - 0.5);
-        libm::cosf(6.0 * x) * libm::sinf(5.0 * y)
-    };
-    let p = |i: usize, j: usize| [i as f32, j as f32, 8.0 * h(i, j)];
-    let mut out = Vec::with_capacity(2 * N * N);
-    for i in 0..N {
-        for j in 0..N {
-            out.push(Triangle {
-                v: [p(i, j), p(i + 1, j), p(i, j + 1)],
-            });
-            out.push(Triangle {
-                v: [p(i + 1, j), p(i + 1, j + 1), p(i, j + 1)],
-            });
-        }
-    }
-    out
-}
-
-fn size() -> bool {
-    let mut ok = true;
-    let (mut rows, mut render_rows) = (Vec::new(), Vec::new());
-    for (target, core, _, _) in TARGETS {
-        println!("\n=== {core} ({target}) ===");
-        let probe = |bin: &str| {
-            let built = run(cargo(&[
-                "build",
-                "--release",
-                "--bin",
-                bin,
-                "--target",
-                target,
-            ]))
-            .0;
-            let path = elf(target, "release", bin);
-            let secs = built.then(|| sections(&path)).flatten();
-            let parts = breakdown(&path).unwrap_or((0, 0, 0));
-            (secs, parts)
-        };
-        let (secs, (builtins, libm, rest)) = probe("size_probe");
-        let (render_secs, (r_builtins, r_libm, r_rest)) = probe("size_probe_render");
-        let (ran, out) = run(cargo(&["test", "--release", "--target", target]));
-        let find = |key: &str| {
-            out.lines()
-                .find_map(|l| l.split_once(key).map(|(_, s)| s.trim().to_string()))
-        };
-        let stack = find("stack high-water: ");
-        let render_stack = find("render stack high-water (f32): ")
-            .zip(find("render stack high-water (fixed): "))
-            .map(|(f, x)| format!("{f} / {x}"));
-        ok &= secs.is_some() && render_secs.is_some() && ran;
-        ok &= stack.is_some() && render_stack.is_some();
-        let (text, rodata) = secs.unwrap_or((0, 0));
-        rows.push(format!(
-            "| {core} (`{target}`) | {text} | {builtins} / {libm} / {rest} | {rodata} | {} |",
-            stack.unwrap_or_else(|| "?".into())
-        ));
-        let (r_text, r_rodata) = render_secs.unwrap_or((0, 0));
-        render_rows.push(format!(
-            "| {core} (`{target}`) | {r_text} | {r_builtins} / {r_libm} / {r_rest} | {r_rodata} | {} |",
-            render_stack.unwrap_or_else(|| "?".into())
-        ));
-    }
-    let mut ico = cases::empty_mesh::<f32>();
-    ok &= cases::icosphere(&mut ico).is_ok();
-    let field = heightfield();
-    println!("\n## Footprint (generated by `cargo xtask size`)\n");
-    println!("Build + traverse probe (`tests/qemu/src/bin/size_probe.rs`: f32 triangles, SAH build, one closest-hit query; release, opt-level \"s\", LTO), and the stack high-water mark of the on-target test `stack_high_water_mark` (icosphere, 80 triangles, SAH build, 96 rays; release):\n");
-    println!("| core | .text B | of which builtins / libm / kernel + startup | .rodata B | stack high-water (bytes) |");
-    println!("|---|---:|---:|---:|---|");
-    for r in &rows {
-        println!("{r}");
-    }
-    println!("\nRenderer probe (`tests/qemu/src/bin/size_probe_render.rs`: the default scene in f32, a BVH per object, `Renderer::new` and one row of sRGB pixels; the renderer links every accelerator it can be asked for), and the stack high-water mark of a whole render of the default scene (on-target tests `render_f32`/`render_fixed`; release):\n");
-    println!("| core | .text B | of which builtins / libm / kernel + startup | .rodata B | render stack f32 / fixed |");
-    println!("|---|---:|---:|---:|---|");
-    for r in &render_rows {
-        println!("{r}");
-    }
-    println!("\nArena bytes per triangle (nodes in use + primitive ids; `nodes_needed` reserves 68 B/tri), leaves of up to 4:\n");
-    println!("| mesh | triangles | sah | median | midpoint |");
-    println!("|---|---:|---:|---:|---:|");
-    for (name, tris) in [
-        ("icosphere level 1", &ico[..]),
-        ("64×64 heightfield", &field[..]),
-    ] {
-        let v = arena_per_tri(tris);
-        ok &= v.len() == 3;
-        let cells: Vec<String> = v.iter().map(|(_, b)| format!("{b:.1}")).collect();
-        println!("| {name} | {} | {} |", tris.len(), cells.join(" | "));
-    }
-    println!(
-        "\nTraversal stack: MAX_DEPTH × 8 = {} B reserved per query.",
-        raykernel::bvh::MAX_DEPTH * 8
-    );
-    ok
 }
 
 #[cfg(test)]

@@ -4,13 +4,15 @@
 //! ([`bvh`], and its 4-wide form [`bvh4`]), a uniform spatial subdivision ([`grid`]) and an axis-aligned binary space
 //! partition ([`kdtree`]); and brute force ([`Linear`]), the reference.
 
-pub mod baked;
-pub mod bvh;
-pub mod bvh4;
-pub mod grid;
-pub mod kdtree;
+pub(crate) mod baked;
+pub(crate) mod bvh;
+pub(crate) mod bvh4;
+mod error;
+pub(crate) mod grid;
+pub(crate) mod kdtree;
 mod linear;
 
+pub use error::{Arena, BuildError};
 pub use linear::Linear;
 
 use crate::geom::{Hit, Primitive, Ray};

@@ -1,5 +1,5 @@
 use super::{Aabb, Ray};
-use crate::error::PointError;
+use crate::scalar::PointError;
 use crate::scalar::Scalar;
 
 /// Something an accelerator can hold: it has bounds and a pure intersection test.

@@ -1,4 +1,4 @@
-use crate::error::RayError;
+use crate::scalar::RayError;
 use crate::scalar::Scalar;
 
 /// A half-line `origin + t·dir` for `t` in `[t_min, t_max]`, with its precomputed test data.

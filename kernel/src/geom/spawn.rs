@@ -41,7 +41,7 @@
 //! these functions on arbitrary scenes.
 
 use super::{Hit, Ray, Triangle};
-use crate::error::RayError;
+use crate::scalar::RayError;
 use crate::scalar::{Scalar, I16F16};
 
 /// Relative offset of the `f32` rule: the origin moves `2^-16·M` off the plane.

@@ -17,8 +17,8 @@ use super::{AccelChoice, SceneError};
 use crate::accel::bvh::{self, Bvh, Node};
 use crate::accel::grid::Grid;
 use crate::accel::kdtree::{self, KdNode, KdTree};
+use crate::accel::BuildError;
 use crate::accel::{Accel, Counters, Linear, Nearest};
-use crate::error::BuildError;
 use crate::geom::spawn::{self, cross, sub, unit, SpawnScalar, MAX_NUDGES};
 use crate::geom::{closer, Aabb, Primitive, Ray, Sphere, Triangle};
 use crate::render::scene::{Item, Light, Problem};
@@ -771,13 +771,13 @@ fn light_geom<S: Scalar>(l: &Light) -> Result<LightGeom<S>, (&'static str, Probl
     }
 }
 
-pub(crate) fn point_problem(e: crate::error::PointError) -> Problem {
+pub(crate) fn point_problem(e: crate::scalar::PointError) -> Problem {
     match e {
-        crate::error::PointError::NonFinite => Problem::NonFinite,
-        crate::error::PointError::OutOfRange { limit } => Problem::OutOfRange {
+        crate::scalar::PointError::NonFinite => Problem::NonFinite,
+        crate::scalar::PointError::OutOfRange { limit } => Problem::OutOfRange {
             min: -limit,
             max: limit,
         },
-        crate::error::PointError::NegativeRadius => Problem::Negative,
+        crate::scalar::PointError::NegativeRadius => Problem::Negative,
     }
 }

@@ -110,7 +110,11 @@ pub(crate) fn sample_radiance<S: SpawnScalar>(
             }
         }
         depth += 1;
-        if throughput == Vec3::ZERO {
+        // The path's weight is spent once every channel is below the normal range: a
+        // subnormal weight times a reflectance below one can round back to itself (the
+        // smallest subnormal times 0.9 is the smallest subnormal), so waiting for zero could
+        // bounce until `max_depth`, however large, for contributions below f32's normal range.
+        if throughput.cmplt(Vec3::splat(f32::MIN_POSITIVE)).all() {
             break;
         }
         let origin = sp.spawn_origin(dir.to_array());

@@ -293,7 +293,7 @@ pub enum Problem {
         available: usize,
     },
     /// A primitive could not be built into the accelerator.
-    Build(crate::error::BuildError),
+    Build(crate::accel::BuildError),
 }
 
 /// Bad scene data, settings or render call: which item, which field, and what is wrong.

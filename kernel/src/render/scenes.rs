@@ -87,7 +87,7 @@ impl<'d> SceneData<'d> {
         }
         for (i, (t, slot)) in self.triangles.iter().zip(out.iter_mut()).enumerate() {
             *slot = Triangle::from_f32(*t).map_err(|(vertex, error)| {
-                let p = Problem::Build(crate::error::BuildError::BadPrimitive {
+                let p = Problem::Build(crate::accel::BuildError::BadPrimitive {
                     prim: i,
                     vertex,
                     error,
@@ -112,7 +112,7 @@ impl<'d> SceneData<'d> {
         }
         for (i, (s, slot)) in self.spheres.iter().zip(out.iter_mut()).enumerate() {
             let bad = |vertex, e| {
-                let p = Problem::Build(crate::error::BuildError::BadPrimitive {
+                let p = Problem::Build(crate::accel::BuildError::BadPrimitive {
                     prim: i,
                     vertex,
                     error: e,
@@ -124,7 +124,7 @@ impl<'d> SceneData<'d> {
                 *slot = S::coord_from_f32(x).map_err(|e| bad(0, e))?;
             }
             if s.radius < 0.0 {
-                return Err(bad(1, crate::error::PointError::NegativeRadius));
+                return Err(bad(1, crate::scalar::PointError::NegativeRadius));
             }
             let r = S::coord_from_f32(s.radius).map_err(|e| bad(1, e))?;
             *slot = Sphere {

@@ -12,7 +12,7 @@
 //!   which bounds the rounding of the reciprocal, so boxes are never culled wrongly.
 
 use super::Scalar;
-use crate::error::{PointError, RayError};
+use super::{PointError, RayError};
 use core::ops::{Add, Div, Mul, Neg, Sub};
 
 /// A signed fixed-point number with 16 integer and 16 fraction bits (`value = raw / 65536`).

@@ -1,10 +1,12 @@
 //! Four `f32` lanes with exactly the per-lane IEEE semantics of scalar code.
 //!
-//! With SSE2 (every `x86_64`) the lanes live in one SSE register; elsewhere in a `[f32; 4]`. Every operation
-//! is the same IEEE operation in each lane on both (SSE arithmetic rounds as scalar `f32`
-//! does, and `min`/`max` are defined as the SSE instructions are, which is how the scalar code
-//! writes them), so code written against [`F4`] gives the same bits on every target. Only
-//! operations the two backends agree on bit for bit belong here.
+//! With SSE2 (every `x86_64`) the lanes live in one SSE register, with NEON (every `aarch64`) in
+//! one NEON register, elsewhere in a `[f32; 4]`. Every operation is the same IEEE operation in
+//! each lane on all three (vector arithmetic rounds as scalar `f32` does, and `min`/`max` are
+//! defined as the SSE instructions are, which is how the scalar code writes them; NEON builds
+//! them from a compare and a select, as its own `fmin`/`fmax` order signed zeros and NaNs
+//! differently), so code written against [`F4`] gives the same bits on every target. Only
+//! operations the backends agree on bit for bit belong here.
 
 #[cfg(target_feature = "sse2")]
 #[allow(unsafe_code)]
@@ -113,7 +115,125 @@ mod sse {
     }
 }
 
-#[cfg(any(test, not(target_feature = "sse2")))]
+#[cfg(all(target_arch = "aarch64", target_feature = "neon"))]
+#[allow(unsafe_code)]
+mod neon {
+    // SAFETY (every `unsafe` block below): these intrinsics have no precondition beyond the
+    // CPU supporting NEON, which `cfg(target_feature = "neon")` guarantees at compile time (it
+    // is part of the aarch64 baseline). Only `vld1q_u32` touches memory: it reads the four
+    // `u32` of a local array, which is valid, aligned and initialised.
+    use core::arch::aarch64::{
+        float32x4_t, uint32x4_t, vaddq_f32, vaddvq_u32, vandq_u32, vbslq_f32, vcgtq_f32, vcleq_f32,
+        vcltq_f32, vcltzq_s32, vcombine_f32, vcvtq_u32_f32, vdivq_f32, vdupq_n_f32, vget_high_f32,
+        vgetq_lane_f32, vld1q_f32, vld1q_u32, vmulq_f32, vreinterpretq_s32_f32, vst1q_f32,
+        vst1q_u32, vsubq_f32, vzip1q_f32, vzip2q_f32,
+    };
+
+    /// Four lanes in a NEON register.
+    #[derive(Clone, Copy)]
+    pub(crate) struct F4(float32x4_t);
+
+    /// Bit `i` set if lane `i` of the all-ones/all-zeros mask `m` is set (SSE's `movemask`).
+    #[inline(always)]
+    fn movemask(m: uint32x4_t) -> u32 {
+        let weights = [1u32, 2, 4, 8];
+        unsafe { vaddvq_u32(vandq_u32(m, vld1q_u32(weights.as_ptr()))) }
+    }
+
+    impl F4 {
+        #[inline(always)]
+        pub(crate) fn new(l: [f32; 4]) -> Self {
+            Self(unsafe { vld1q_f32(l.as_ptr()) })
+        }
+        #[inline(always)]
+        pub(crate) fn splat(x: f32) -> Self {
+            Self(unsafe { vdupq_n_f32(x) })
+        }
+        #[inline(always)]
+        pub(crate) fn add(self, o: Self) -> Self {
+            Self(unsafe { vaddq_f32(self.0, o.0) })
+        }
+        #[inline(always)]
+        pub(crate) fn sub(self, o: Self) -> Self {
+            Self(unsafe { vsubq_f32(self.0, o.0) })
+        }
+        #[inline(always)]
+        pub(crate) fn mul(self, o: Self) -> Self {
+            Self(unsafe { vmulq_f32(self.0, o.0) })
+        }
+        #[inline(always)]
+        pub(crate) fn div(self, o: Self) -> Self {
+            Self(unsafe { vdivq_f32(self.0, o.0) })
+        }
+        /// The lanes in order.
+        #[inline(always)]
+        pub(crate) fn to_array(self) -> [f32; 4] {
+            let mut out = [0.0f32; 4];
+            unsafe { vst1q_f32(out.as_mut_ptr(), self.0) };
+            out
+        }
+        /// Per lane `if a < b { a } else { b }` (the second operand when unordered).
+        #[inline(always)]
+        pub(crate) fn min(self, o: Self) -> Self {
+            Self(unsafe { vbslq_f32(vcltq_f32(self.0, o.0), self.0, o.0) })
+        }
+        /// Per lane `if a > b { a } else { b }` (the second operand when unordered).
+        #[inline(always)]
+        pub(crate) fn max(self, o: Self) -> Self {
+            Self(unsafe { vbslq_f32(vcgtq_f32(self.0, o.0), self.0, o.0) })
+        }
+        /// `[a0, b0, a1, b1]`.
+        #[inline(always)]
+        pub(crate) fn unpack_lo(self, o: Self) -> Self {
+            Self(unsafe { vzip1q_f32(self.0, o.0) })
+        }
+        /// `[a2, b2, a3, b3]`.
+        #[inline(always)]
+        pub(crate) fn unpack_hi(self, o: Self) -> Self {
+            Self(unsafe { vzip2q_f32(self.0, o.0) })
+        }
+        /// `[a2, a3, a2, a3]`.
+        #[inline(always)]
+        pub(crate) fn high_half(self) -> Self {
+            Self(unsafe { vcombine_f32(vget_high_f32(self.0), vget_high_f32(self.0)) })
+        }
+        /// Per lane `(x as i32).clamp(0, top)` for a whole `top` in `0..=2^24`: the lane
+        /// clamped to `[0, top]` (NaN to 0), then truncated, which is exact in that range.
+        #[inline(always)]
+        pub(crate) fn clamped_trunc(self, top: f32) -> [u32; 4] {
+            let x = self.max(Self::splat(0.0)).min(Self::splat(top));
+            let mut out = [0u32; 4];
+            unsafe { vst1q_u32(out.as_mut_ptr(), vcvtq_u32_f32(x.0)) };
+            out
+        }
+        /// Bit `i` set if lane `i` of `self <= o` (false when unordered).
+        #[inline(always)]
+        pub(crate) fn le_mask(self, o: Self) -> u32 {
+            movemask(unsafe { vcleq_f32(self.0, o.0) })
+        }
+        /// Bit `i` set if lane `i`'s sign bit is set.
+        #[inline(always)]
+        pub(crate) fn sign_mask(self) -> u32 {
+            movemask(unsafe { vcltzq_s32(vreinterpretq_s32_f32(self.0)) })
+        }
+        #[inline(always)]
+        pub(crate) fn lane0(self) -> f32 {
+            unsafe { vgetq_lane_f32::<0>(self.0) }
+        }
+        #[inline(always)]
+        pub(crate) fn lane1(self) -> f32 {
+            unsafe { vgetq_lane_f32::<1>(self.0) }
+        }
+    }
+}
+
+#[cfg(any(
+    test,
+    not(any(
+        target_feature = "sse2",
+        all(target_arch = "aarch64", target_feature = "neon")
+    ))
+))]
 mod portable {
     /// Four lanes in an array.
     #[derive(Clone, Copy)]
@@ -210,7 +330,12 @@ mod portable {
     }
 }
 
-#[cfg(not(target_feature = "sse2"))]
+#[cfg(all(target_arch = "aarch64", target_feature = "neon"))]
+pub(crate) use neon::F4;
+#[cfg(not(any(
+    target_feature = "sse2",
+    all(target_arch = "aarch64", target_feature = "neon")
+)))]
 pub(crate) use portable::F4;
 #[cfg(target_feature = "sse2")]
 pub(crate) use sse::F4;
@@ -219,12 +344,16 @@ pub(crate) use sse::F4;
 mod tests {
     use super::F4;
 
-    /// Every operation of the SSE backend against the portable one, bit for bit, on lanes
-    /// drawn from a list of awkward values (NaN, infinities, signed zeros, subnormals).
-    #[cfg(target_feature = "sse2")]
+    /// Every operation of the target's vector backend (SSE or NEON) against the portable one,
+    /// bit for bit in all four lanes, on lanes drawn from a list of awkward values (NaN,
+    /// infinities, signed zeros, subnormals).
+    #[cfg(any(
+        target_feature = "sse2",
+        all(target_arch = "aarch64", target_feature = "neon")
+    ))]
     #[test]
-    fn sse_and_portable_backends_agree_bit_for_bit() {
-        use super::{portable::F4 as P, sse::F4 as S};
+    fn vector_and_portable_backends_agree_bit_for_bit() {
+        use super::{portable::F4 as P, F4 as S};
         let values = [
             0.0,
             -0.0,
@@ -254,6 +383,11 @@ mod tests {
                     bits(p.lane0(), p.lane1()),
                     bits(s.lane0(), s.lane1()),
                     "{what} {a:?} {b:?}"
+                );
+                assert_eq!(
+                    p.to_array().map(f32::to_bits),
+                    s.to_array().map(f32::to_bits),
+                    "{what} (all lanes) {a:?} {b:?}"
                 );
             };
             same(pa.add(pb), sa.add(sb), "add");

@@ -5,15 +5,16 @@
 //! prepared, the conservative slab test, and the exact-as-possible primitive tests. Each mode's
 //! numerics sit in its own file (`float.rs`, `fixed.rs`).
 
+mod error;
 mod fixed;
 mod float;
 pub(crate) mod lanes;
 mod wide;
 
-pub use fixed::{FixedRay, Vec3x, FIXED_COORD_LIMIT, I16F16};
-pub use float::{FloatRay, F32_COORD_LIMIT};
+pub use error::{PointError, RayError};
+pub use fixed::{Vec3x, FIXED_COORD_LIMIT, I16F16};
+pub use float::F32_COORD_LIMIT;
 
-use crate::error::{PointError, RayError};
 use core::fmt::Debug;
 
 mod sealed {

@@ -4,8 +4,8 @@
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
 use raykernel::{
-    kdtree, Accel, Bvh, Bvh4, Grid, GridOptions, Hit, KdNode, KdOptions, KdTree, Node, Node4,
-    PointError, Primitive, Ray, Scalar, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16,
+    grid::GridOptions, kdtree, kdtree::KdOptions, Accel, Bvh, Bvh4, Grid, Hit, KdNode, KdTree,
+    Node, Node4, PointError, Primitive, Ray, Scalar, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16,
 };
 use std::fmt;
 use std::ops::{Add, Mul, Sub};

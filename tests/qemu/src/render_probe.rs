@@ -15,7 +15,7 @@ use raykernel::render::{
     Renderer, Settings, Shape, Tile,
 };
 use raykernel::spawn::SpawnScalar;
-use raykernel::{GridOptions, KdNode, KdOptions, Node, Sphere, Triangle};
+use raykernel::{grid::GridOptions, kdtree::KdOptions, KdNode, Node, Sphere, Triangle};
 
 const TRIS: usize = 24;
 const SPHERES: usize = 4;

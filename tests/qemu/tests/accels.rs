@@ -9,7 +9,7 @@ use cortex_m_rt as _; // defmt-test doesn't link it; the vector table and reset 
 use defmt_semihosting as _; // global logger: defmt frames to semihosting stdout
 use panic_probe as _; // prints the panic via defmt, then `udf` -> HardFault
 
-use raykernel::{kdtree, Grid, GridOptions, KdNode, KdOptions, KdTree, Linear};
+use raykernel::{grid::GridOptions, kdtree, kdtree::KdOptions, Grid, KdNode, KdTree, Linear};
 use raykernel_qemu::cases::{self, Bits, Fail, ICO_TRIS};
 
 #[defmt::panic_handler]
@@ -71,7 +71,7 @@ fn grid_vs_linear<S: Bits>() {
     .err();
     defmt::assert!(
         e == Some(raykernel::BuildError::ArenaTooSmall {
-            arena: raykernel::error::Arena::Refs,
+            arena: raykernel::Arena::Refs,
             needed: need,
             available: need - 1,
         }),
@@ -103,7 +103,7 @@ fn kdtree_vs_linear<S: Bits>() {
     let e = KdTree::build(&tris, &mut nodes[..short], &mut refs, KdOptions::default()).err();
     defmt::assert!(
         e == Some(raykernel::BuildError::ArenaTooSmall {
-            arena: raykernel::error::Arena::Nodes,
+            arena: raykernel::Arena::Nodes,
             needed: short + 1,
             available: short,
         }),

@@ -427,7 +427,10 @@ mod tests {
         // size histogram, about 0.8 KB; 1.3 KB on the M0) on top: 8.6 KB on the M4F, 9.1 KB on
         // the M0.
         defmt::assert!(tf > 0 && tx > 0 && bf > tf && bx > tx);
-        defmt::assert!(bf.max(bx).max(tf).max(tx) < 10 * 1024, "over 10 KB of stack");
+        defmt::assert!(
+            bf.max(bx).max(tf).max(tx) < 10 * 1024,
+            "over 10 KB of stack"
+        );
     }
     /// Last test: how much of the stack the whole run used. Fails when less than 512 bytes of
     /// the target's RAM stay free, before an overflow would.

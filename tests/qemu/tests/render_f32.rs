@@ -43,9 +43,10 @@ mod tests {
     /// row of pixels) of the default scene, printed for the footprint table.
     #[test]
     fn render_stack_high_water_mark() {
-        let used = stack::stack_use(|| {
-            defmt::assert!(cases::render_hash::<f32>(&scenes::CORNELL).is_ok())
-        });
+        let used =
+            stack::stack_use(
+                || defmt::assert!(cases::render_hash::<f32>(&scenes::CORNELL).is_ok()),
+            );
         defmt::println!("render stack high-water (f32): {=usize} B", used);
     }
 }

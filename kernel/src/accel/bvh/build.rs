@@ -7,7 +7,7 @@ use super::{
     nodes_needed, BuildOptions, BuilderKind, Node, FIRST_PAIR, MAX_DEPTH, MAX_LEAF_SIZE,
     MEDIAN_FALLBACK_DEPTH,
 };
-use crate::error::{Arena, BuildError};
+use crate::accel::{Arena, BuildError};
 use crate::geom::{Aabb, Primitive};
 use crate::scalar::lanes::F4;
 use crate::scalar::Scalar;

@@ -28,7 +28,7 @@ pub(crate) use traverse::{test_leaf, LeafPrims};
 pub(crate) use validate::check_permutation;
 pub use validate::{InvalidTree, TreeStats};
 
-use crate::error::BuildError;
+use crate::accel::BuildError;
 use crate::geom::Primitive;
 use crate::scalar::Scalar;
 use core::marker::PhantomData;
@@ -115,13 +115,18 @@ pub struct BuildOptions {
     pub reinsertion: bool,
 }
 
+impl BuildOptions {
+    /// The defaults: SAH, [`DEFAULT_LEAF_SIZE`], reinsertion on.
+    pub const DEFAULT: Self = Self {
+        builder: BuilderKind::Sah,
+        max_leaf_size: DEFAULT_LEAF_SIZE,
+        reinsertion: true,
+    };
+}
+
 impl Default for BuildOptions {
     fn default() -> Self {
-        Self {
-            builder: BuilderKind::Sah,
-            max_leaf_size: DEFAULT_LEAF_SIZE,
-            reinsertion: true,
-        }
+        Self::DEFAULT
     }
 }
 
@@ -192,7 +197,7 @@ impl<'a, S: Scalar, P: Primitive<S>> Bvh<'a, S, P> {
         let Some(ids) = prim_ids.get_mut(..prims.len()) else {
             // Unreachable: `build` checked the size.
             return Err(BuildError::ArenaTooSmall {
-                arena: crate::error::Arena::PrimIds,
+                arena: crate::accel::Arena::PrimIds,
                 needed: prims.len(),
                 available,
             });

@@ -3,7 +3,7 @@
 use super::node::Node4;
 use super::nodes4_needed;
 use crate::accel::bvh::{half_area, Node};
-use crate::error::{Arena, BuildError};
+use crate::accel::{Arena, BuildError};
 use crate::scalar::Scalar;
 
 /// A node still to be filled: `child[0]` is its BVH2 source (an inner node), `count[0]` its

@@ -26,7 +26,7 @@ mod validate;
 pub use node::Node4;
 
 use crate::accel::bvh::Bvh;
-use crate::error::BuildError;
+use crate::accel::BuildError;
 use crate::geom::Primitive;
 use crate::scalar::Scalar;
 use core::marker::PhantomData;

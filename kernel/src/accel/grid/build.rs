@@ -1,7 +1,7 @@
 //! Grid construction: bounds, resolution, counting pass, fill pass; and the checker.
 
 use super::{Grid, GridOptions, GridSize, GridStats, InvalidGrid, Layout, MAX_DENSITY, MAX_RES};
-use crate::error::{Arena, BuildError};
+use crate::accel::{Arena, BuildError};
 use crate::geom::{Aabb, Primitive};
 use crate::scalar::Scalar;
 

@@ -46,7 +46,7 @@
 mod build;
 mod traverse;
 
-use crate::error::BuildError;
+use crate::accel::BuildError;
 use crate::geom::Primitive;
 use crate::scalar::Scalar;
 use core::marker::PhantomData;
@@ -67,11 +67,16 @@ pub struct GridOptions {
     pub density: f32,
 }
 
+impl GridOptions {
+    /// The defaults: density [`DEFAULT_DENSITY`].
+    pub const DEFAULT: Self = Self {
+        density: DEFAULT_DENSITY,
+    };
+}
+
 impl Default for GridOptions {
     fn default() -> Self {
-        Self {
-            density: DEFAULT_DENSITY,
-        }
+        Self::DEFAULT
     }
 }
 

@@ -3,7 +3,7 @@
 use super::{
     nodes_needed, refs_needed, InvalidKdTree, KdNode, KdOptions, KdStats, KdTree, MAX_DEPTH,
 };
-use crate::error::{Arena, BuildError};
+use crate::accel::{Arena, BuildError};
 use crate::geom::{Aabb, Primitive};
 use crate::scalar::Scalar;
 

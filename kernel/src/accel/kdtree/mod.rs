@@ -35,7 +35,7 @@
 mod build;
 mod traverse;
 
-use crate::error::BuildError;
+use crate::accel::BuildError;
 use crate::geom::{Aabb, Primitive};
 use crate::scalar::Scalar;
 use core::marker::PhantomData;
@@ -68,6 +68,11 @@ pub const fn refs_needed(prim_count: usize) -> usize {
 pub struct KdOptions {
     /// Depth limit, at most [`MAX_DEPTH`]; 0 means `min(MAX_DEPTH, 8 + 1.3·log2(n))`.
     pub max_depth: u32,
+}
+
+impl KdOptions {
+    /// The defaults: the automatic depth rule.
+    pub const DEFAULT: Self = Self { max_depth: 0 };
 }
 
 /// One kd-tree node: 12 bytes in both modes.

@@ -10,8 +10,8 @@
 use core::hint::black_box;
 use cortex_m_rt::entry;
 use raykernel::{
-    kdtree, Accel, Grid, GridOptions, KdNode, KdOptions, KdTree, Primitive, Ray, Scalar, Sphere,
-    TraversalStats, Triangle, I16F16,
+    grid::GridOptions, kdtree, kdtree::KdOptions, Accel, Grid, KdNode, KdTree, Primitive, Ray,
+    Scalar, Sphere, TraversalStats, Triangle, I16F16,
 };
 
 const N: usize = 8;

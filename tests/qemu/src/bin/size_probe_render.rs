@@ -1,11 +1,13 @@
 //! Size probe of the renderer: the default built-in scene (`f32`, one BVH per object) converted
 //! into caller buffers, `Renderer::new`, and one row rendered to sRGB bytes; nothing else (no
 //! defmt, a spinning panic handler). `cargo xtask size` reports its `.text`/`.rodata` next to
-//! the build + traverse probe (`size_probe.rs`).
+//! the build + traverse probe (`size_probe.rs`) and runs it under QEMU to measure its stack (the
+//! arrays below included): the only measuring code is the store to [`PROBE_DONE`].
 #![no_std]
 #![no_main]
 
 use core::hint::black_box;
+use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m_rt::entry;
 use raykernel::bvh::{nodes_needed, BuildOptions};
 use raykernel::render::scenes::{self, SceneData};
@@ -17,6 +19,13 @@ const SPHERES: usize = 4;
 const OBJECTS: usize = 8;
 const WIDTH: usize = 64;
 
+/// Set to `DONE` when the row has been rendered; `cargo xtask size` polls it (in .bss).
+#[no_mangle]
+static PROBE_DONE: AtomicU32 = AtomicU32::new(0);
+/// "DONE", as `xtask/src/size.rs` expects.
+const DONE: u32 = 0x444f_4e45;
+
+#[inline(never)]
 fn render_row(data: &SceneData<'_>) -> Option<()> {
     let mut tris = [Triangle::<f32> { v: [[0.0; 3]; 3] }; TRIS];
     let mut spheres = [Sphere::<f32> {
@@ -55,6 +64,7 @@ fn render_row(data: &SceneData<'_>) -> Option<()> {
 #[entry]
 fn main() -> ! {
     black_box(render_row(black_box(&scenes::CORNELL)));
+    PROBE_DONE.store(DONE, Ordering::Relaxed);
     loop {
         cortex_m::asm::wfi();
     }

@@ -1,0 +1,292 @@
+//! Interleaved rounds: the headline contender (the 4-wide BVH collapsed from the SAH BVH,
+//! `f32`) and the peers it is compared with trace one ray set in alternation, round after
+//! round: ours per ray (each ray constructed from its record in the timed loop), Embree HIGH
+//! (`rtcIntersect1` on the raw records, with the `embree` feature), ours on pre-built rays,
+//! tinybvh's BVH2 on pre-built rays (with the `tinybvh` feature); then again. Each structure
+//! is built once; only tracing is timed. The per-round ratios pair like with like: ours per
+//! ray ÷ Embree (both pay their ray setup), ours pre-built ÷ tinybvh (neither does).
+//!
+//! Why: on a shared VM a slow spell (another tenant's memory traffic) can last seconds to
+//! minutes, long enough to cover one contender's consecutive runs and not the other's. In
+//! alternation both see every spell, so the per-round ratio compares like with like. Each
+//! contender's fastest round is reported too: such noise only ever adds time, so the minimum
+//! time is the estimate least disturbed by it (Chen and Revels 2016, "Robust benchmarking in
+//! noisy environments").
+
+use crate::error::Error;
+use crate::ours::{mrays, RunOptions};
+use crate::workload::{BenchScene, RayKind, RaySet};
+use host::rayfile::RayRecord;
+use host::trace::{
+    build_and_visit, median, prepare_rays, trace_closest, trace_closest_per_ray, AccelConfig,
+    AccelKind, AccelVisitor, NodeArena, PreparedRays,
+};
+use raykernel::Accel;
+use serde::Serialize;
+
+/// One ray set's rounds: Mrays/s of each contender in each round, in round order (a
+/// contender this build lacks has no figures).
+#[derive(Clone, Debug, Serialize)]
+pub struct RoundsRow {
+    /// Scene.
+    pub scene: String,
+    /// Ray set.
+    pub rays: RayKind,
+    /// Rays traced per round.
+    pub ray_count: usize,
+    /// Ours (4-wide BVH, SAH, `f32`, closest hit), each ray constructed in the loop.
+    pub ours_mrays: Vec<f64>,
+    /// Ours on pre-built rays.
+    pub ours_prebuilt_mrays: Vec<f64>,
+    /// Embree 3 HIGH, `rtcIntersect1` on the raw records.
+    pub embree_mrays: Vec<f64>,
+    /// tinybvh's BVH2 on pre-built rays.
+    pub tinybvh_mrays: Vec<f64>,
+}
+
+/// Median, fastest round, and per-round ratios of two series of figures.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pairing {
+    /// Median of ours.
+    pub ours_median: f64,
+    /// Ours' fastest round.
+    pub ours_best: f64,
+    /// Median of the peer.
+    pub peer_median: f64,
+    /// The peer's fastest round.
+    pub peer_best: f64,
+    /// Ours ÷ peer within each round.
+    pub ratios: Vec<f64>,
+}
+
+impl Pairing {
+    /// `None` without the peer's figures.
+    #[must_use]
+    pub fn of(ours: &[f64], peer: &[f64]) -> Option<Self> {
+        if peer.is_empty() {
+            return None;
+        }
+        Some(Self {
+            ours_median: median(ours),
+            ours_best: best(ours),
+            peer_median: median(peer),
+            peer_best: best(peer),
+            ratios: ours
+                .iter()
+                .zip(peer)
+                .filter(|(_, &p)| p > 0.0)
+                .map(|(o, p)| o / p)
+                .collect(),
+        })
+    }
+
+    /// Median per-round ratio.
+    #[must_use]
+    pub fn median_ratio(&self) -> f64 {
+        median(&self.ratios)
+    }
+
+    /// Smallest and largest per-round ratio.
+    #[must_use]
+    pub fn ratio_range(&self) -> (f64, f64) {
+        let lo = self.ratios.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = self.ratios.iter().copied().fold(0.0, f64::max);
+        (lo, hi)
+    }
+}
+
+impl RoundsRow {
+    /// Ours per ray against Embree HIGH (`None` without Embree).
+    #[must_use]
+    pub fn vs_embree(&self) -> Option<Pairing> {
+        Pairing::of(&self.ours_mrays, &self.embree_mrays)
+    }
+
+    /// Ours pre-built against tinybvh (`None` without tinybvh).
+    #[must_use]
+    pub fn vs_tinybvh(&self) -> Option<Pairing> {
+        Pairing::of(&self.ours_prebuilt_mrays, &self.tinybvh_mrays)
+    }
+}
+
+/// The largest figure (0 for none).
+fn best(xs: &[f64]) -> f64 {
+    xs.iter().copied().fold(0.0, f64::max)
+}
+
+/// The headline configuration: 4-wide BVH, default (SAH) build, no leaf order.
+#[must_use]
+pub fn headline_config() -> AccelConfig {
+    AccelConfig {
+        accel: AccelKind::Bvh4,
+        build: raykernel::bvh::BuildOptions::default(),
+        leaf_order: false,
+    }
+}
+
+/// Runs `rounds` rounds on one ray set (every `opts.stride`-th ray), with the peers this
+/// build has when `with_peers`.
+///
+/// # Errors
+/// A build the kernel refuses.
+pub fn run(
+    scene: &BenchScene,
+    set: &RaySet,
+    opts: RunOptions,
+    rounds: usize,
+    with_peers: bool,
+) -> Result<RoundsRow, Error> {
+    let tris = scene.mesh.kernel_triangles::<f32>(&scene.path)?;
+    let prepared = prepare_rays::<f32>(&set.records, opts.stride);
+    let config = headline_config();
+    let mut arena = NodeArena::<f32>::for_accel(config.accel, &tris);
+    let visitor = Alternate {
+        scene,
+        records: &set.records,
+        prepared: &prepared,
+        stride: opts.stride.max(1),
+        rounds: rounds.max(1),
+        with_peers,
+    };
+    let (_, figures) = build_and_visit(&tris, &mut arena, &scene.path, &config, visitor)?;
+    Ok(RoundsRow {
+        scene: scene.name.clone(),
+        rays: set.kind,
+        ray_count: prepared.rays.len(),
+        ours_mrays: figures.ours,
+        ours_prebuilt_mrays: figures.ours_prebuilt,
+        embree_mrays: figures.embree,
+        tinybvh_mrays: figures.tinybvh,
+    })
+}
+
+/// Visits the built headline structure: the rounds themselves.
+struct Alternate<'p> {
+    scene: &'p BenchScene,
+    records: &'p [RayRecord],
+    prepared: &'p PreparedRays<f32>,
+    stride: usize,
+    rounds: usize,
+    with_peers: bool,
+}
+
+#[derive(Default)]
+struct Figures {
+    ours: Vec<f64>,
+    ours_prebuilt: Vec<f64>,
+    embree: Vec<f64>,
+    tinybvh: Vec<f64>,
+}
+
+impl AccelVisitor<f32> for Alternate<'_> {
+    type Output = Figures;
+
+    fn visit<A: Accel<f32>>(self, accel: &A) -> Figures {
+        let n = self.prepared.rays.len();
+        let mut figures = Figures::default();
+        let inputs = EmbreeInputs::new(self.scene, self.records, self.with_peers);
+        let embree = inputs.build();
+        let round = |figures: &mut Figures| {
+            let per_ray = trace_closest_per_ray(accel, self.records, self.stride).1;
+            figures.ours.push(mrays(n, per_ray));
+            if let Some(e) = &embree {
+                figures.embree.push(e.trace(self.stride));
+            }
+            let prebuilt = trace_closest(accel, self.prepared).1;
+            figures.ours_prebuilt.push(mrays(n, prebuilt));
+        };
+        let tinybvh = self.with_peers.then(|| {
+            let tris: Vec<[[f32; 3]; 3]> = (0..self.scene.mesh.triangle_count())
+                .map(|i| self.scene.mesh.triangle_f32(i))
+                .collect();
+            let records: Vec<&RayRecord> = self.records.iter().step_by(self.stride).collect();
+            crate::peers::alternate_with_tinybvh(&tris, &records, self.rounds, &mut || {
+                round(&mut figures);
+            })
+        });
+        match tinybvh.flatten() {
+            Some(t) => figures.tinybvh = t,
+            // No tinybvh in this build (or it refused the scene): the rounds without it.
+            None => {
+                for _ in 0..self.rounds {
+                    round(&mut figures);
+                }
+            }
+        }
+        figures
+    }
+}
+
+/// Embree HIGH for the rounds, with the `embree` feature: a device, the scene's geometry and
+/// flat records ([`EmbreeInputs::new`]), and the scene built once over them
+/// ([`EmbreeInputs::build`]). Without the feature, nothing.
+#[cfg(feature = "embree")]
+struct EmbreeInputs {
+    device: Option<crate::embree::Device>,
+    geometry: crate::embree::Geometry,
+    flat: Vec<f32>,
+}
+
+#[cfg(feature = "embree")]
+impl EmbreeInputs {
+    fn new(scene: &BenchScene, records: &[RayRecord], wanted: bool) -> Self {
+        use crate::embree::{flat_records, Device, Geometry};
+        Self {
+            device: if wanted { Device::new() } else { None },
+            geometry: Geometry::of(&scene.mesh),
+            flat: if wanted {
+                flat_records(records)
+            } else {
+                Vec::new()
+            },
+        }
+    }
+
+    fn build(&self) -> Option<EmbreeTracer<'_>> {
+        use crate::embree::{Quality, Scene};
+        let device = self.device.as_ref()?;
+        let (scene, _) = Scene::build(device, &self.geometry, Quality::High)?;
+        Some(EmbreeTracer {
+            scene,
+            flat: &self.flat,
+        })
+    }
+}
+
+#[cfg(feature = "embree")]
+struct EmbreeTracer<'a> {
+    scene: crate::embree::Scene<'a>,
+    flat: &'a [f32],
+}
+
+#[cfg(feature = "embree")]
+impl EmbreeTracer<'_> {
+    fn trace(&self, stride: usize) -> f64 {
+        let (hits, ms) = self.scene.closest(self.flat, stride);
+        mrays(hits.len(), ms)
+    }
+}
+
+#[cfg(not(feature = "embree"))]
+struct EmbreeInputs;
+
+#[cfg(not(feature = "embree"))]
+impl EmbreeInputs {
+    fn new(_: &BenchScene, _: &[RayRecord], _: bool) -> Self {
+        Self
+    }
+
+    fn build(&self) -> Option<EmbreeTracer> {
+        None
+    }
+}
+
+#[cfg(not(feature = "embree"))]
+struct EmbreeTracer;
+
+#[cfg(not(feature = "embree"))]
+impl EmbreeTracer {
+    fn trace(&self, _: usize) -> f64 {
+        0.0
+    }
+}

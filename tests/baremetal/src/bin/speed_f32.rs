@@ -1,0 +1,9 @@
+//! Instructions per ray and per pixel in `f32` (see `speed.rs`).
+#![no_std]
+#![no_main]
+
+#[cfg_attr(target_arch = "riscv32", riscv_rt::entry)]
+#[cfg_attr(target_arch = "arm", cortex_m_rt::entry)]
+fn main() -> ! {
+    raykernel_baremetal::speed::run::<f32>()
+}

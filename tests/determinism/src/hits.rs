@@ -1,0 +1,135 @@
+//! Hit files of a generated mesh and ray set, through every accelerator in both modes.
+//!
+//! The mesh is a 24×24 heightfield of a smooth bump (1152 triangles, shared edges and
+//! vertices), the rays 2048 seeded rays: most from above aiming down into the field, a quarter
+//! grazing it from the side, some with a bounded interval. Everything is computed from `f32`
+//! basic operations and `libm`, so every target feeds the kernel the same bits.
+
+use super::cases::Rng;
+use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
+use raykernel::bvh4::nodes4_needed;
+use raykernel::grid::GridOptions;
+use raykernel::kdtree::{self, KdOptions};
+use raykernel::{
+    Accel, Bvh, Bvh4, Grid, KdNode, KdTree, Linear, Node, Node4, Ray, Scalar, Triangle, I16F16,
+};
+use std::path::Path;
+
+/// Heightfield cells per side.
+const FIELD: usize = 24;
+/// Rays in the set.
+const RAYS: usize = 2048;
+
+/// The heightfield's triangles as `f32` vertices.
+fn mesh() -> Vec<[[f32; 3]; 3]> {
+    let h = |i: usize, j: usize| {
+        let (x, y) = (i as f32 / FIELD as f32 - 0.5, j as f32 / FIELD as f32 - 0.5);
+        3.0 * libm::cosf(5.0 * x) * libm::sinf(4.0 * y + 0.5)
+    };
+    let p = |i: usize, j: usize| [i as f32 - 12.0, j as f32 - 12.0, h(i, j)];
+    let mut out = Vec::with_capacity(2 * FIELD * FIELD);
+    for i in 0..FIELD {
+        for j in 0..FIELD {
+            out.push([p(i, j), p(i + 1, j), p(i, j + 1)]);
+            out.push([p(i + 1, j), p(i + 1, j + 1), p(i, j + 1)]);
+        }
+    }
+    out
+}
+
+/// The ray set as (origin, direction, t_min, t_max).
+fn rays() -> Vec<([f32; 3], [f32; 3], f32, f32)> {
+    let mut rng = Rng::new(0xd37e_4a11_57a7_e5ee);
+    (0..RAYS)
+        .map(|i| {
+            let (o, d) = if i % 4 == 3 {
+                // Grazing: from one side, nearly horizontal.
+                let o = [-14.0, rng.range(-12.0, 12.0), rng.range(-3.0, 3.0)];
+                (o, [1.0, rng.range(-0.3, 0.3), rng.range(-0.1, 0.1)])
+            } else {
+                let o = [rng.range(-10.0, 10.0), rng.range(-10.0, 10.0), 8.0];
+                let target = [rng.range(-13.0, 13.0), rng.range(-13.0, 13.0), 0.0];
+                (o, core::array::from_fn(|k| target[k] - o[k]))
+            };
+            let t_max = if i % 8 == 5 {
+                rng.range(4.0, 12.0)
+            } else {
+                f32::INFINITY
+            };
+            (o, d, 0.0, t_max)
+        })
+        .collect()
+}
+
+/// Closest hits as hit-file records; a miss (or a ray the kernel rejects) is `+inf, u32::MAX`.
+fn trace<S: Scalar, A: Accel<S>>(accel: &A, rays: &[Option<Ray<S>>]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(8 * rays.len());
+    for r in rays {
+        let (t, prim) = match r.as_ref().and_then(|r| accel.intersect(r)) {
+            Some(hit) => (hit.t.to_f32(), hit.prim),
+            None => (f32::INFINITY, u32::MAX),
+        };
+        out.extend_from_slice(&t.to_le_bytes());
+        out.extend_from_slice(&prim.to_le_bytes());
+    }
+    out
+}
+
+/// Writes `<accel>_<mode>.hits` for every accelerator and both modes into `dir`; returns each
+/// file's name and record count.
+pub fn write_all(dir: &Path) -> Result<Vec<(String, usize)>, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut files = Vec::new();
+    mode::<f32>(dir, &mut files)?;
+    mode::<I16F16>(dir, &mut files)?;
+    Ok(files)
+}
+
+fn mode<S: Scalar>(dir: &Path, files: &mut Vec<(String, usize)>) -> Result<(), String> {
+    let tris = mesh()
+        .into_iter()
+        .map(Triangle::<S>::from_f32)
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| format!("{} mesh rejected: {e:?}", S::NAME))?;
+    let rays: Vec<Option<Ray<S>>> = rays()
+        .into_iter()
+        .map(|(o, d, t0, t1)| Ray::from_f32(o, d, t0, t1).ok())
+        .collect();
+    let mut save = |accel: &str, bytes: Vec<u8>| {
+        let name = format!("{accel}_{}.hits", S::NAME);
+        std::fs::write(dir.join(&name), &bytes).map_err(|e| format!("{name}: {e}"))?;
+        files.push((name, bytes.len() / 8));
+        Ok::<(), String>(())
+    };
+    let fail = |what: &str, e: raykernel::BuildError| format!("{} {what}: {e}", S::NAME);
+
+    save("linear", trace(&Linear::new(&tris), &rays))?;
+    for builder in BuilderKind::ALL {
+        let mut nodes = vec![Node::<S>::EMPTY; nodes_needed(tris.len())];
+        let mut ids = vec![0u32; tris.len()];
+        let options = BuildOptions {
+            builder,
+            max_leaf_size: 4,
+            reinsertion: true,
+        };
+        let bvh = Bvh::build(&tris, &mut nodes, &mut ids, options).map_err(|e| fail("bvh", e))?;
+        save(&format!("bvh_{}", builder.name()), trace(&bvh, &rays))?;
+        if builder == BuilderKind::Sah {
+            let mut wide = vec![Node4::<S>::EMPTY; nodes4_needed(tris.len())];
+            let bvh4 = Bvh4::collapse(&bvh, &mut wide).map_err(|e| fail("bvh4", e))?;
+            save("bvh4_sah", trace(&bvh4, &rays))?;
+        }
+    }
+    let options = GridOptions::default();
+    let size = Grid::size_for(&tris, options).map_err(|e| fail("grid", e))?;
+    let (mut cells, mut refs) = (vec![0u32; size.cells], vec![0u32; size.refs]);
+    let grid = Grid::build(&tris, &mut cells, &mut refs, options).map_err(|e| fail("grid", e))?;
+    save("grid", trace(&grid, &rays))?;
+    let mut kd_nodes = vec![KdNode::<S>::EMPTY; kdtree::nodes_needed(tris.len())];
+    let mut kd_refs = vec![0u32; kdtree::refs_needed(tris.len())];
+    let options = KdOptions::default();
+    let kd =
+        KdTree::build(&tris, &mut kd_nodes, &mut kd_refs, options).map_err(|e| fail("kd", e))?;
+    save("kdtree", trace(&kd, &rays))?;
+    Ok(())
+}
