@@ -187,7 +187,7 @@ enum RkStatus rk_build(uint32_t mode,
                        struct RkAccel *out);
 
 /**
- * Loads baked bytes (`host bake`'s output, e.g. in flash) in place and fills `out`: every
+ * Loads baked bytes (`raykernel bake`'s output, e.g. in flash) in place and fills `out`: every
  * byte is checked, nothing is copied. `bytes` must start at a multiple of
  * `rk_baked_align()` and stay unmodified while `out` is used.
  */

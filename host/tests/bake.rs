@@ -1,4 +1,4 @@
-//! `host bake` and `host trace-baked`: on a generated mesh (and on `../shared`'s suzanne when
+//! `raykernel bake` and `raykernel trace-baked`: on a generated mesh (and on `../shared`'s suzanne when
 //! present), in both modes and both trees, tracing the baked file gives hit files
 //! byte-identical to `host trace` building the same tree in process; a corrupted file is
 //! refused with the loader's error.
@@ -135,7 +135,7 @@ fn baked_files_trace_like_the_built_trees_on_suzanne() {
 
 /// The on-target test's input: an undistorted icosphere (level 2, 320 triangles, radius 1.2)
 /// baked as an f32 4-wide BVH, and its grid hash. Both files are rewritten with `BLESS=1`;
-/// otherwise they must equal what `host bake` writes now.
+/// otherwise they must equal what `raykernel bake` writes now.
 #[test]
 fn on_target_baked_mesh_is_what_host_bake_writes() {
     let dir = temp_dir("bake-golden");

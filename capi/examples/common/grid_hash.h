@@ -2,7 +2,7 @@
  * around the axis, each traced for the closest hit and any hit; the hash is FNV-1a (32-bit)
  * over, per ray in row order, the hit's triangle index and the bits of its distance (both
  * little-endian u32; RK_NO_HIT and 0 for a miss) and one byte for the any-hit answer.
- * `host bake` prints the same hash of the tree it built (`grid_hash`), so C on any target can
+ * `raykernel bake` prints the same hash of the tree it built (`grid_hash`), so C on any target can
  * be checked against the Rust side. Compile with -ffp-contract=off: the ray directions must be
  * the separately rounded float operations written here. */
 #ifndef RAYKERNEL_GRID_HASH_H

@@ -22,6 +22,6 @@ output=$(timeout 120 qemu-system-arm -machine mps2-an386 -cpu cortex-m4 -nograph
 echo "$output"
 rm -rf "$out"
 if [ -n "$expect" ] && ! grep -q "grid_hash 0x$expect" <<<"$output"; then
-    echo "firmware hash differs from the host's ($expect)" >&2
+    echo "firmware hash differs from raykernel bake's ($expect)" >&2
     exit 1
 fi
