@@ -394,7 +394,7 @@ fn build_in<S: Scalar>(
     Ok((Tree::Bvh4(wide), arrays))
 }
 
-/// Loads baked bytes (`host bake`'s output, e.g. in flash) in place and fills `out`: every
+/// Loads baked bytes (`raykernel bake`'s output, e.g. in flash) in place and fills `out`: every
 /// byte is checked, nothing is copied. `bytes` must start at a multiple of
 /// `rk_baked_align()` and stay unmodified while `out` is used.
 #[no_mangle]

@@ -13,6 +13,9 @@ fn generate() -> String {
                 .into(),
         ),
         cpp_compat: true,
+        // Freestanding headers only: the firmware's compiler has no C library.
+        no_includes: true,
+        sys_includes: vec!["stdbool.h".into(), "stddef.h".into(), "stdint.h".into()],
         usize_is_size_t: true,
         enumeration: cbindgen::EnumConfig {
             rename_variants: cbindgen::RenameRule::ScreamingSnakeCase,

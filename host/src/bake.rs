@@ -1,5 +1,5 @@
-//! `host bake` (build a BVH or 4-wide BVH over an OBJ mesh and write it as a baked file,
-//! `docs/BAKED_FORMAT.md`) and `host trace-baked` (load a baked file in place, as a device
+//! `raykernel bake` (build a BVH or 4-wide BVH over an OBJ mesh and write it as a baked file,
+//! `docs/BAKED_FORMAT.md`) and `raykernel trace-baked` (load a baked file in place, as a device
 //! would, and trace a ray file through it).
 
 use crate::error::Error;
@@ -36,7 +36,7 @@ impl BakeAccel {
     }
 }
 
-/// `host bake SCENE.obj --out FILE [--accel bvh|bvh4] [--mode f32|fixed] [--leaf N]`.
+/// `raykernel bake SCENE.obj --out FILE [--accel bvh|bvh4] [--mode f32|fixed] [--leaf N]`.
 #[derive(Clone, Debug, Args)]
 pub struct BakeArgs {
     /// The mesh (Wavefront OBJ).
@@ -62,7 +62,7 @@ pub struct BakeArgs {
     pub leaf_order: bool,
 }
 
-/// The JSON report of `host bake`.
+/// The JSON report of `raykernel bake`.
 #[derive(Clone, Debug, Serialize)]
 pub struct BakeReport {
     /// The mesh.
@@ -188,7 +188,7 @@ fn bake_triangles<S: BakedScalar>(
     }
 }
 
-/// `host bake`: build, bake, write.
+/// `raykernel bake`: build, bake, write.
 ///
 /// # Errors
 /// As [`bake_mesh_file`]; an unwritable output.
@@ -220,10 +220,10 @@ pub fn run_bake(args: &BakeArgs) -> Result<BakeReport, Error> {
     })
 }
 
-/// `host trace-baked FILE RAYS --out HITS`.
+/// `raykernel trace-baked FILE RAYS --out HITS`.
 #[derive(Clone, Debug, Args)]
 pub struct TraceBakedArgs {
-    /// The baked file (from `host bake`).
+    /// The baked file (from `raykernel bake`).
     pub baked: PathBuf,
     /// The rays: 32-byte records `ox oy oz dx dy dz tmin tmax`, little-endian f32.
     pub rays: PathBuf,
@@ -232,7 +232,7 @@ pub struct TraceBakedArgs {
     pub out: PathBuf,
 }
 
-/// The JSON report of `host trace-baked`.
+/// The JSON report of `raykernel trace-baked`.
 #[derive(Clone, Debug, Serialize)]
 pub struct TraceBakedReport {
     /// The baked file.
@@ -299,7 +299,7 @@ fn trace_in<S: BakedScalar>(
     Ok((hits, load_ms, trace_ms, grid_hash(&baked)))
 }
 
-/// `host trace-baked`: load the baked file, trace, write the hits.
+/// `raykernel trace-baked`: load the baked file, trace, write the hits.
 ///
 /// # Errors
 /// Unreadable inputs, a baked file the loader refuses, an unwritable output.

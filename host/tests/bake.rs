@@ -1,4 +1,4 @@
-//! `host bake` and `host trace-baked`: on a generated mesh (and on `../shared`'s suzanne when
+//! `raykernel bake` and `raykernel trace-baked`: on a generated mesh (and on `../shared`'s suzanne when
 //! present), in both modes and both trees, tracing the baked file gives hit files
 //! byte-identical to `host trace` building the same tree in process; a corrupted file is
 //! refused with the loader's error.
@@ -132,4 +132,50 @@ fn baked_files_trace_like_the_built_trees_on_suzanne() {
     )
     .unwrap();
     check_scene(&obj, &rays, &dir);
+}
+
+/// The on-target test's input: an undistorted icosphere (level 2, 320 triangles, radius 1.2)
+/// baked as an f32 4-wide BVH, and its grid hash. Both files are rewritten with `BLESS=1`;
+/// otherwise they must equal what `raykernel bake` writes now.
+#[test]
+fn on_target_baked_mesh_is_what_host_bake_writes() {
+    let dir = temp_dir("bake-golden");
+    let (verts, faces) = unit_icosphere(2);
+    let mut text = String::new();
+    for v in &verts {
+        writeln!(text, "v {} {} {}", v[0] * 1.2, v[1] * 1.2, v[2] * 1.2).unwrap();
+    }
+    for f in &faces {
+        writeln!(text, "f {} {} {}", f[0] + 1, f[1] + 1, f[2] + 1).unwrap();
+    }
+    let obj = dir.join("ico.obj");
+    std::fs::write(&obj, text).unwrap();
+    let out = dir.join("ico.bvh4");
+    let report = run_bake(&BakeArgs {
+        scene: obj,
+        out: out.clone(),
+        accel: BakeAccel::Bvh4,
+        mode: Mode::F32,
+        builder: Builder::Sah,
+        leaf: DEFAULT_LEAF_SIZE,
+        leaf_order: false,
+    })
+    .unwrap();
+    let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/golden");
+    let (file, hash) = (
+        golden.join("baked_ico.bvh4"),
+        golden.join("baked_ico.grid_hash"),
+    );
+    let bytes = std::fs::read(&out).unwrap();
+    if std::env::var_os("BLESS").is_some() {
+        std::fs::write(&file, &bytes).unwrap();
+        std::fs::write(&hash, format!("{}\n", report.grid_hash)).unwrap();
+    }
+    assert!(
+        std::fs::read(&file).unwrap_or_default() == bytes,
+        "{} is stale: BLESS=1 cargo test -p raykernel-host --test bake",
+        file.display()
+    );
+    let committed = std::fs::read_to_string(&hash).unwrap_or_default();
+    assert_eq!(committed.trim(), report.grid_hash, "{}", hash.display());
 }

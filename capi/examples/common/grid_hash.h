@@ -2,14 +2,13 @@
  * around the axis, each traced for the closest hit and any hit; the hash is FNV-1a (32-bit)
  * over, per ray in row order, the hit's triangle index and the bits of its distance (both
  * little-endian u32; RK_NO_HIT and 0 for a miss) and one byte for the any-hit answer.
- * `host bake` prints the same hash of the tree it built (`grid_hash`), so C on any target can
+ * `raykernel bake` prints the same hash of the tree it built (`grid_hash`), so C on any target can
  * be checked against the Rust side. Compile with -ffp-contract=off: the ray directions must be
  * the separately rounded float operations written here. */
 #ifndef RAYKERNEL_GRID_HASH_H
 #define RAYKERNEL_GRID_HASH_H
 
 #include <stdint.h>
-#include <string.h>
 #include "raykernel.h"
 
 #define RK_GRID_N 32
@@ -41,10 +40,11 @@ static uint32_t rk_grid_hash(const RkAccel *accel, RkStatus *status) {
                 *status = s;
                 return 0;
             }
-            uint32_t t_bits = 0;
-            if (hit.prim != RK_NO_HIT) {
-                memcpy(&t_bits, &hit.t, 4);
-            }
+            union {
+                float f;
+                uint32_t u;
+            } t = {hit.t};
+            uint32_t t_bits = hit.prim != RK_NO_HIT ? t.u : 0u;
             h = rk_fnv1a(h, hit.prim, 4);
             h = rk_fnv1a(h, t_bits, 4);
             h = rk_fnv1a(h, any ? 1u : 0u, 1);

@@ -18,10 +18,10 @@ arm-none-eabi-gcc -mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 -O2
     -o "$out/firmware.elf"
 arm-none-eabi-size "$out/firmware.elf"
 output=$(timeout 120 qemu-system-arm -machine mps2-an386 -cpu cortex-m4 -nographic -monitor none \
-    -semihosting-config enable=on,target=native -kernel "$out/firmware.elf")
+    -semihosting-config enable=on,target=native -kernel "$out/firmware.elf" 2>&1)
 echo "$output"
 rm -rf "$out"
 if [ -n "$expect" ] && ! grep -q "grid_hash 0x$expect" <<<"$output"; then
-    echo "firmware hash differs from the host's ($expect)" >&2
+    echo "firmware hash differs from raykernel bake's ($expect)" >&2
     exit 1
 fi

@@ -1,5 +1,5 @@
 /* The baked mesh in flash, aligned as the loader needs (128 bytes); mesh.bin is
- * `host bake`'s output, found on the assembler's include path. */
+ * `raykernel bake`'s output, found on the assembler's include path. */
     .section .rodata.baked_mesh, "a"
     .balign 128
     .global baked_mesh
@@ -10,3 +10,4 @@ baked_mesh_end:
     .global baked_mesh_len
 baked_mesh_len:
     .word baked_mesh_end - baked_mesh
+    .section .note.GNU-stack, "", %progbits

@@ -1,7 +1,7 @@
 /* Host test of the C interface (gcc): every status named, builds in both modes and both tree
  * kinds answering alike, typed errors for bad arguments, refit equal to a rebuild, and, given
  * a baked file (argv[1]), loading it in place and printing the check grid's hash (compared
- * with argv[2] when given: the hash `host bake` printed for the tree it built).
+ * with argv[2] when given: the hash `raykernel bake` printed for the tree it built).
  * Build: gcc -std=c11 -ffp-contract=off -I capi/include -I capi/examples/common
  *        capi/tests/c/capi_test.c target/debug/libraykernel_c.a -lpthread -ldl -lm */
 #include <stdio.h>
@@ -160,7 +160,7 @@ static int test_baked(const char *path, const char *expect) {
     printf("grid_hash %08x\n", h);
     if (expect != NULL) {
         unsigned long want = strtoul(expect, NULL, 16);
-        CHECK(h == (uint32_t)want, "hash %08x, host bake said %08lx", h, want);
+        CHECK(h == (uint32_t)want, "hash %08x, raykernel bake said %08lx", h, want);
     }
     static float v[9 * TRIS];
     CHECK(rk_refit(&accel, v, TRIS) == RK_STATUS_ERR_NOT_REFITTABLE, "refit of baked bytes");
