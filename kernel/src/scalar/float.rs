@@ -397,6 +397,7 @@ fn zero_area(v: &[[f32; 3]; 3]) -> bool {
     let e1: [f32; 3] = core::array::from_fn(|i| v[1][i] - v[0][i]);
     let e2: [f32; 3] = core::array::from_fn(|i| v[2][i] - v[0][i]);
     for (i, j) in [(1, 2), (2, 0), (0, 1)] {
+        let (i, j) = (i.min(2), j.min(2)); // no-ops that show the compiler the bounds
         let (p, q) = (e1[i] * e2[j], e1[j] * e2[i]);
         if abs(p - q) > (abs(p) + abs(q)) * REL + ABS {
             return false;
@@ -405,6 +406,7 @@ fn zero_area(v: &[[f32; 3]; 3]) -> bool {
     let d1: [(f32, f32); 3] = core::array::from_fn(|i| two_sum(v[1][i], -v[0][i]));
     let d2: [(f32, f32); 3] = core::array::from_fn(|i| two_sum(v[2][i], -v[0][i]));
     [(1, 2), (2, 0), (0, 1)].iter().all(|&(i, j)| {
+        let (i, j) = (i.min(2), j.min(2)); // as above
         let m = abs(d1[i].0)
             .max_of(abs(d1[j].0))
             .max_of(abs(d2[i].0))
