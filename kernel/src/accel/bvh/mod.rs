@@ -23,7 +23,7 @@ mod validate;
 mod walk;
 
 pub use node::Node;
-pub(crate) use refit::{check_prims, leaf_bounds};
+pub(crate) use refit::{leaf_bounds, refit_nodes};
 pub use refit::{RefitError, TreeShape};
 pub(crate) use traverse::{test_leaf, LeafPrims};
 pub(crate) use validate::check_permutation;

@@ -75,6 +75,24 @@ pub(crate) fn check_prims<S: Scalar, P: Primitive<S>>(prims: &[P]) -> Result<(),
     Ok(())
 }
 
+/// What both trees' refits check first: the primitives, and that `prim_ids` and the shape's
+/// node count fit them. Returns the nodes in use.
+pub(crate) fn refit_nodes<'n, S: Scalar, P: Primitive<S>, N>(
+    prims: &[P],
+    nodes: &'n mut [N],
+    prim_ids: &[u32],
+    shape: TreeShape,
+) -> Result<&'n mut [N], RefitError> {
+    check_prims(prims)?;
+    let count = shape.node_count;
+    if prim_ids.len() != prims.len() || (count == 0) != prims.is_empty() {
+        return Err(RefitError::ShapeMismatch { node: 0 });
+    }
+    nodes
+        .get_mut(..count)
+        .ok_or(RefitError::ShapeMismatch { node: count })
+}
+
 /// The padded union of the boxes of the leaf `prim_ids[first..first + count]`'s primitives.
 pub(crate) fn leaf_bounds<S: Scalar, P: Primitive<S>>(
     (prim_ids, prims, leaf_order): (&[u32], &[P], bool),
@@ -115,13 +133,9 @@ impl<'a, S: Scalar, P: Primitive<S>> Bvh<'a, S, P> {
         prim_ids: &'a [u32],
         shape: TreeShape,
     ) -> Result<Self, RefitError> {
-        check_prims(prims)?;
-        let count = shape.node_count;
+        let nodes = refit_nodes(prims, nodes, prim_ids, shape)?;
+        let count = nodes.len();
         let mismatch = |node| RefitError::ShapeMismatch { node };
-        if prim_ids.len() != prims.len() || (count == 0) != prims.is_empty() {
-            return Err(mismatch(0));
-        }
-        let nodes = nodes.get_mut(..count).ok_or(mismatch(count))?;
         // Children sit after their parent, so a reverse sweep sees them refitted first.
         for i in (0..count).rev() {
             if i == 1 && count > 1 {

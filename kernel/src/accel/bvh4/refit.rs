@@ -2,7 +2,7 @@
 //! (see the binary tree's refit for the rule).
 
 use super::{Bvh4, Node4};
-use crate::accel::bvh::{check_prims, leaf_bounds};
+use crate::accel::bvh::{leaf_bounds, refit_nodes};
 use crate::accel::bvh::{RefitError, TreeShape};
 use crate::geom::{Aabb, Primitive};
 use crate::scalar::Scalar;
@@ -30,13 +30,9 @@ impl<'a, S: Scalar, P: Primitive<S>> Bvh4<'a, S, P> {
         prim_ids: &'a [u32],
         shape: TreeShape,
     ) -> Result<Self, RefitError> {
-        check_prims(prims)?;
-        let count = shape.node_count;
+        let nodes = refit_nodes(prims, nodes, prim_ids, shape)?;
+        let count = nodes.len();
         let mismatch = |node| RefitError::ShapeMismatch { node };
-        if prim_ids.len() != prims.len() || (count == 0) != prims.is_empty() {
-            return Err(mismatch(0));
-        }
-        let nodes = nodes.get_mut(..count).ok_or(mismatch(count))?;
         // Wide nodes are breadth-first, children after parents: refit in reverse.
         for i in (0..count).rev() {
             let node = nodes.get(i).copied().ok_or(mismatch(i))?;
