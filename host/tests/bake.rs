@@ -179,3 +179,25 @@ fn on_target_baked_mesh_is_what_host_bake_writes() {
     let committed = std::fs::read_to_string(&hash).unwrap_or_default();
     assert_eq!(committed.trim(), report.grid_hash, "{}", hash.display());
 }
+
+/// The committed baked file, loaded in place as the firmware loads it, gives the committed
+/// grid hash (the on-target test asserts the same on each Cortex-M core).
+#[test]
+fn committed_baked_file_loads_to_the_committed_grid_hash() {
+    #[repr(C, align(128))]
+    struct Aligned<T: ?Sized>(T);
+    let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/golden");
+    let bytes = std::fs::read(golden.join("baked_ico.bvh4")).unwrap();
+    let mut aligned = Box::new(Aligned([0u8; 1 << 16]));
+    assert!(
+        bytes.len() <= aligned.0.len(),
+        "golden bake grew past the test buffer"
+    );
+    aligned.0[..bytes.len()].copy_from_slice(&bytes);
+    let tree = raykernel::baked::load_bvh4::<f32>(&aligned.0[..bytes.len()]).unwrap();
+    let committed = std::fs::read_to_string(golden.join("baked_ico.grid_hash")).unwrap();
+    assert_eq!(
+        format!("{:08x}", host::bake::grid_hash(&tree)),
+        committed.trim()
+    );
+}
