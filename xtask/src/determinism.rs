@@ -12,8 +12,8 @@
 //! - Cortex-M4F, M3, M0 (`qemu-system-arm`): the defmt-test suite of `tests/qemu`, whose golden
 //!   tests check the same file.
 //!
-//! Prints a per-architecture summary, writes the table into docs/PLATFORMS.md and ends with
-//! one `N passed, M failed` line.
+//! Prints a per-architecture summary, writes the table into docs/PLATFORMS.md and the README,
+//! and ends with one `N passed, M failed` line.
 
 use super::{platforms, progress, run, TARGETS};
 use std::path::{Path, PathBuf};
@@ -298,7 +298,9 @@ pub fn determinism() -> bool {
         .fold((0, 0), |(p, f), r| (p + r.passed, f + r.failed));
     // The table is written only when every architecture passed, so the committed one is never
     // a failing run's.
-    let written = failed == 0 && platforms::write_block("determinism", &table);
+    let written = failed == 0
+        && platforms::write_block(platforms::Doc::Platforms, "determinism", &table)
+        && platforms::write_block(platforms::Doc::Readme, "determinism", &table);
     let failed = failed + usize::from(failed == 0 && !written);
     println!("{passed} passed, {failed} failed");
     failed == 0

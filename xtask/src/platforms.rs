@@ -1,16 +1,27 @@
-//! The generated blocks of `docs/PLATFORMS.md`: each sits between a begin and an end marker
-//! and is replaced whole by the command that owns it.
+//! The generated blocks of `docs/PLATFORMS.md` and the README: each sits between a begin and
+//! an end marker and is replaced whole by the command that owns it.
 
 use std::path::{Path, PathBuf};
 
-fn doc_path() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/PLATFORMS.md")
+/// The documents that hold generated blocks.
+#[derive(Clone, Copy)]
+pub enum Doc {
+    Platforms,
+    Readme,
 }
 
-/// Replaces the block called `name` of docs/PLATFORMS.md with `body`; false (and a message)
-/// if the file or its markers are missing.
-pub fn write_block(name: &str, body: &str) -> bool {
-    let path = doc_path();
+fn doc_path(doc: Doc) -> PathBuf {
+    let file = match doc {
+        Doc::Platforms => "../docs/PLATFORMS.md",
+        Doc::Readme => "../README.md",
+    };
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(file)
+}
+
+/// Replaces the block called `name` of `doc` with `body`; false (and a message) if the file or
+/// its markers are missing.
+pub fn write_block(doc: Doc, name: &str, body: &str) -> bool {
+    let path = doc_path(doc);
     let begin = format!("<!-- begin {name}: generated, do not edit -->\n");
     let end = format!("<!-- end {name} -->");
     let Ok(text) = std::fs::read_to_string(&path) else {

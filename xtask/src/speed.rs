@@ -89,7 +89,7 @@ pub fn speed() -> bool {
         }
     }
     println!("\n=== speed table ===\n{table}");
-    ok = ok && platforms::write_block("speed", &table);
+    ok = ok && platforms::write_block(platforms::Doc::Platforms, "speed", &table);
     println!("{} passed, {} failed", usize::from(ok), usize::from(!ok));
     ok
 }
