@@ -132,6 +132,19 @@ pub fn figures(r: &BenchResults) -> Vec<Figure> {
             x.incoherent_nodes_per_ray,
         );
     }
+    for x in &r.refit {
+        let contender = format!("raykernel refit {}", x.mode);
+        for (figure, value) in [
+            ("rebuild_ms", x.rebuild_ms),
+            ("refit_bvh_ms", x.refit_bvh_ms),
+            ("refit_bvh4_ms", x.refit_bvh4_ms),
+            ("rebuilt_mrays_prebuilt", x.rebuilt_mrays),
+            ("refitted_mrays_prebuilt", x.refitted_mrays),
+            ("differing_hits", x.differing_hits as f64),
+        ] {
+            push(&x.scene, "primary", &contender, figure, value);
+        }
+    }
     for x in &r.overhead {
         let contender = format!("raykernel render {} {}", x.workload, x.mode);
         for (figure, value) in [

@@ -13,6 +13,7 @@
 //!   round,
 //! - [`accuracy`]: the `f64` reference and each contender's hit-distance error,
 //! - [`scale`]: the tiled scene from 10k to 1M+ triangles,
+//! - [`refit`]: refitting the trees after the mesh moved, against rebuilding them,
 //! - [`images`]: the renderer's image error against time, per sampler,
 //! - [`overhead`]: the renderer against hand-written casters (the render plan's cost),
 //! - [`report`], [`figures`], [`plot`], [`stats`]: Markdown, CSV, JSON and PNG output,
@@ -35,6 +36,7 @@ pub mod ours;
 pub mod overhead;
 pub mod peers;
 pub mod plot;
+pub mod refit;
 pub mod report;
 pub mod results;
 pub mod rounds;
@@ -177,6 +179,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
         let meshes: Vec<&host::obj::Mesh> = scenes.iter().map(|s| &s.mesh).collect();
         scale::run(&meshes, &config.scale)?
     };
+    let refit_rows = refit::run(&scenes, opts)?;
     eprintln!("bench: render overhead");
     let overhead_rows = overhead::run(if config.quick { 3 } else { 31 });
     let image_rows = match &config.images {
@@ -211,6 +214,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
         rounds: round_rows,
         reference: references,
         scale: scale_rows,
+        refit: refit_rows,
         images: image_rows,
         overhead: overhead_rows,
         slopes: Vec::new(),

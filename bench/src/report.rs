@@ -7,6 +7,7 @@ use crate::images::ImageRow;
 use crate::machine::Machine;
 use crate::overhead::OverheadRow;
 use crate::plot::{grouped_bars, loglog, Series};
+use crate::refit::RefitRow;
 use crate::results::{ScaleRow, TraceRow};
 use crate::rounds::RoundsRow;
 use crate::workload::RayKind;
@@ -37,6 +38,8 @@ pub struct BenchResults {
     pub reference: Vec<ReferenceRow>,
     /// The tiled-scene sweep.
     pub scale: Vec<ScaleRow>,
+    /// Refit against rebuild, per scene and mode.
+    pub refit: Vec<RefitRow>,
     /// The image-convergence renders.
     pub images: Vec<ImageRow>,
     /// The renderer against hand-written casters.
@@ -431,6 +434,7 @@ pub fn markdown(r: &BenchResults) -> String {
     peers_section(&mut s, r);
     accuracy_section(&mut s, r);
     s.push_str(&images_section(r));
+    refit_section(&mut s, r);
     overhead_section(&mut s, r);
     scale_section(&mut s, r);
     notes_section(&mut s);
@@ -904,6 +908,46 @@ fn accuracy_section(s: &mut String, r: &BenchResults) {
     let _ = writeln!(s, "| plot | series | slope |\n|---|---|---:|");
     for sl in r.slopes.iter().filter(|x| x.plot.starts_with("error")) {
         let _ = writeln!(s, "| {} | {} | {:.2} |", sl.plot, sl.series, sl.slope);
+    }
+    let _ = writeln!(s);
+}
+
+fn refit_section(s: &mut String, r: &BenchResults) {
+    if r.refit.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "## Refit: new boxes for a moved mesh, against rebuilding\n\n\
+         Every vertex moves by a smooth field of amplitude {:.0}% of the scene box's diagonal \
+         (`bench/src/refit.rs`). Rebuild: the SAH BVH and its 4-wide collapse over the moved \
+         mesh; refit: `Bvh::refit` and `Bvh4::refit` of the trees built before the motion \
+         (same topology, new boxes). Then the primary rays through each 4-wide tree \
+         (pre-built rays): the refitted tree's loss per ray, and its hits, which must equal \
+         the rebuilt tree's. Medians of {} runs; single thread.\n",
+        r.refit.first().map_or(0.0, |x| x.amplitude * 100.0),
+        r.runs
+    );
+    let _ = writeln!(
+        s,
+        "| scene | triangles | mode | rebuild ms | refit BVH ms | refit BVH4 ms | rebuilt Mrays/s | refitted Mrays/s | rays | differing hits |\n\
+         |---|---:|---|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for x in &r.refit {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {} |",
+            x.scene,
+            x.triangles,
+            x.mode,
+            x.rebuild_ms,
+            x.refit_bvh_ms,
+            x.refit_bvh4_ms,
+            x.rebuilt_mrays,
+            x.refitted_mrays,
+            x.rays,
+            x.differing_hits
+        );
     }
     let _ = writeln!(s);
 }

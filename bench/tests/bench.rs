@@ -210,6 +210,30 @@ fn bench_writes_a_well_formed_report_csv_json_and_plots() {
     assert_eq!(scale.len(), 4);
     assert!(scale[0]["triangles"].as_u64().unwrap() >= 500);
 
+    // Refit: both scenes in both modes; the refitted tree gives the rebuilt tree's hits.
+    for scene in ["ball", "fine"] {
+        for mode in ["f32", "fixed"] {
+            let contender = format!("raykernel refit {mode}");
+            assert_eq!(
+                figure(rows, scene, "primary", &contender, "differing_hits"),
+                0.0
+            );
+            for name in ["rebuild_ms", "refit_bvh_ms", "refit_bvh4_ms"] {
+                assert!(figure(rows, scene, "primary", &contender, name) > 0.0);
+            }
+            assert!(
+                figure(
+                    rows,
+                    scene,
+                    "primary",
+                    &contender,
+                    "refitted_mrays_prebuilt"
+                ) > 0.0
+            );
+        }
+    }
+    assert!(report.contains("## Refit: new boxes for a moved mesh"));
+
     // Images: three samplers at 1, 2 and 4 spp; more samples, less error (the renders are
     // deterministic, so this is a fixed fact of this scene, not a chance).
     for sampler in ["independent", "stratified", "sobol"] {
