@@ -301,7 +301,11 @@ impl FloatRay {
     /// the binade 2^60 ([`scale_to_2_60`], so the exact products do not underflow), and U, V,
     /// W by `det`'s binade so that `det` lies in the binade 2^60 (so `num` cannot overflow, nor
     /// small weights underflow). `None` if `det` is zero.
-    #[inline(always)]
+    ///
+    /// Inlined on hosted targets (speed); bare-metal targets keep one copy for the distance
+    /// and the barycentrics (flash).
+    #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline(never))]
     fn scaled(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> Option<([Df; 3], Df, Df)> {
         let mut m = 0.0f32;
         for p in [a, b, c] {
