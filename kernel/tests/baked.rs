@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::{query, same_hit, Rng, TestScalar};
+use common::{query, same_hit, TestScalar};
 use raykernel::baked::{
     bake_bvh, bake_bvh4, baked_len, checksum, load_bvh, load_bvh4, read_header, BakedKind,
     BakedScalar, HEADER_LEN, MAX_ALIGN,
@@ -17,6 +17,7 @@ use raykernel::baked::{
 use raykernel::bvh::{nodes_needed, BuildOptions};
 use raykernel::bvh4::nodes4_needed;
 use raykernel::{Accel, BakeError, Baked, Bvh, Bvh4, Linear, Node, Node4, Ray, Triangle, I16F16};
+use raykernel_testkit::Rng;
 
 /// A byte buffer whose `bytes()` start at a multiple of [`MAX_ALIGN`] (plus `shift`).
 struct Aligned {

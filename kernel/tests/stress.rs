@@ -11,7 +11,7 @@
 
 mod common;
 
-use common::{Rng, TestScalar};
+use common::TestScalar;
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::spawn::{offset_origin, spawn_ray, spawn_shadow_ray, SpawnScalar};
 use raykernel::{
@@ -19,6 +19,9 @@ use raykernel::{
     KdNode, KdTree, Linear, Node, PointError, Primitive, Ray, RayError, Scalar, Triangle, Vec3x,
     I16F16,
 };
+use raykernel_testkit::icosphere::unit_icosphere;
+use raykernel_testkit::vec3::{cross, dot, normalize, sub};
+use raykernel_testkit::Rng;
 use std::collections::{BTreeMap, HashMap};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
@@ -185,27 +188,9 @@ fn to_f64<S: Mode>(p: [S; 3]) -> [f64; 3] {
     p.map(SpawnScalar::to_f64)
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn unit(v: [f64; 3]) -> [f64; 3] {
-    let l = dot(v, v).sqrt();
-    v.map(|x| x / l)
-}
-
 fn tri_normal<S: Mode>(t: &Triangle<S>) -> [f64; 3] {
     let v = t.v.map(to_f64::<S>);
-    unit(cross(sub(v[1], v[0]), sub(v[2], v[0])))
+    normalize(cross(sub(v[1], v[0]), sub(v[2], v[0])))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -305,7 +290,7 @@ impl Mesh {
 }
 
 fn icosphere(level: u32) -> Mesh {
-    let (verts, faces) = common::unit_icosphere(level);
+    let (verts, faces) = unit_icosphere(level);
     Mesh {
         name: format!("icosphere{level}"),
         shape: Shape::Sphere,
@@ -1155,9 +1140,9 @@ fn spawned<S: Mode>(meshes: &[Mesh]) {
                     .map(|k| gv[0][k] + af * (gv[1][k] - gv[0][k]) + bf * (gv[2][k] - gv[0][k]));
                 // Offset the target toward the shading point's *offset* origin: the raw hit
                 // point may lie on an edge shared with the target's triangle, i.e. on its plane.
-                let to_target = S::array_to_vec(unit(sub(gq, hp)).map(S::from_f64_dir));
+                let to_target = S::array_to_vec(normalize(sub(gq, hp)).map(S::from_f64_dir));
                 let o_ref = to_f64(offset_origin(&tri, hit.u, hit.v, to_target));
-                let toward = S::array_to_vec(unit(sub(o_ref, gq)).map(S::from_f64_dir));
+                let toward = S::array_to_vec(normalize(sub(o_ref, gq)).map(S::from_f64_dir));
                 let target = offset_origin(&gt, ga, gb, toward);
                 if let Ok(sr) = spawn_shadow_ray(&ray, &hit, &tri, target) {
                     shadow.rays += 1;

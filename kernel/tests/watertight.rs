@@ -13,9 +13,11 @@
 
 mod common;
 
-use common::{all_options, p, with_bvh, with_grid, with_kdtree, RaySpec, Rng, TestScalar};
+use common::{all_options, p, with_bvh, with_grid, with_kdtree, RaySpec, TestScalar};
 use raykernel::bvh::{BuildOptions, BuilderKind};
 use raykernel::{Accel, Linear, Ray, Triangle, I16F16};
+use raykernel_testkit::icosphere::unit_icosphere;
+use raykernel_testkit::Rng;
 use std::collections::HashMap;
 
 const SEED: u64 = 0x0a7e_7715_0001;
@@ -73,7 +75,7 @@ impl Mesh {
 /// index), scaled to `radius`; each vertex's radius is multiplied by `1 + jitter·r`,
 /// `r` uniform in [-1, 1).
 fn icosphere(level: u32, radius: f64, jitter: f32, rng: &mut Rng) -> Mesh {
-    let (verts, faces) = common::unit_icosphere(level);
+    let (verts, faces) = unit_icosphere(level);
     let verts = verts
         .iter()
         .map(|v| {

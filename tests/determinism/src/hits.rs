@@ -5,7 +5,6 @@
 //! grazing it from the side, some with a bounded interval. Everything is computed from `f32`
 //! basic operations and `libm`, so every target feeds the kernel the same bits.
 
-use super::cases::Rng;
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
 use raykernel::grid::GridOptions;
@@ -13,6 +12,7 @@ use raykernel::kdtree::{self, KdOptions};
 use raykernel::{
     Accel, Bvh, Bvh4, Grid, KdNode, KdTree, Linear, Node, Node4, Ray, Scalar, Triangle, I16F16,
 };
+use raykernel_testkit::Rng;
 use std::path::Path;
 
 /// Heightfield cells per side.
