@@ -94,10 +94,7 @@ fn run<S: BakedScalar>(ctl: u8, rest: &[u8]) {
     let Ok(tree) = Baked::<S>::load(bytes) else {
         return;
     };
-    let (ids, prims, leaf_order) = match &tree {
-        Baked::Bvh(t) => (t.prim_ids(), t.prims(), t.is_leaf_order()),
-        Baked::Bvh4(t) => (t.prim_ids(), t.prims(), t.is_leaf_order()),
-    };
+    let (ids, prims, leaf_order) = (tree.prim_ids(), tree.prims(), tree.is_leaf_order());
     let mut by_id = prims.to_vec();
     if leaf_order {
         for (slot, &id) in ids.iter().enumerate() {
