@@ -26,7 +26,7 @@ pub use write::{bake_bvh, bake_bvh4, baked_len};
 
 use crate::accel::bvh::{Bvh, Node, RefitError, TreeShape};
 use crate::accel::bvh4::{Bvh4, Node4};
-use crate::accel::{Accel, Counters, Nearest};
+use crate::accel::{Accel, AnyAccel, Counters, Nearest};
 use crate::geom::{Ray, Triangle};
 
 /// A loaded baked tree of either kind.
@@ -47,6 +47,38 @@ impl<'a, S: BakedScalar> Baked<'a, S> {
         match read_header(bytes)?.kind {
             BakedKind::Bvh => load_bvh(bytes).map(Self::Bvh),
             BakedKind::Bvh4 => load_bvh4(bytes).map(Self::Bvh4),
+        }
+    }
+
+    /// The tree inside `accel`, if it is one of the two kinds a baked file holds.
+    #[must_use]
+    pub fn from_any(accel: AnyAccel<'a, S, Triangle<S>>) -> Option<Self> {
+        match accel {
+            AnyAccel::Bvh(t) => Some(Self::Bvh(t)),
+            AnyAccel::Bvh4(t) => Some(Self::Bvh4(t)),
+            AnyAccel::Linear(_) | AnyAccel::Grid(_) | AnyAccel::KdTree(_) => None,
+        }
+    }
+
+    /// The length of this tree's baked file ([`baked_len`]); `None` if the format cannot
+    /// hold it.
+    #[must_use]
+    pub fn baked_len(&self) -> Option<usize> {
+        let nodes = match self {
+            Self::Bvh(t) => t.nodes().len(),
+            Self::Bvh4(t) => t.nodes().len(),
+        };
+        baked_len(self.kind(), nodes, self.prims().len())
+    }
+
+    /// Writes this tree into `out` ([`bake_bvh`], [`bake_bvh4`]); returns the bytes written.
+    ///
+    /// # Errors
+    /// As the writers.
+    pub fn bake(&self, out: &mut [u8]) -> Result<usize, BakeError> {
+        match self {
+            Self::Bvh(t) => bake_bvh(t, out),
+            Self::Bvh4(t) => bake_bvh4(t, out),
         }
     }
 
