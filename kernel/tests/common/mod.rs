@@ -4,9 +4,11 @@
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
 use raykernel::{
-    grid::GridOptions, kdtree, kdtree::KdOptions, Accel, Bvh, Bvh4, Grid, Hit, KdNode, KdTree,
-    Node, Node4, PointError, Primitive, Ray, Scalar, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16,
+    grid::GridOptions, kdtree, kdtree::KdOptions, Accel, AccelKind, AnyAccel, Bvh, Bvh4, Grid, Hit,
+    KdNode, KdTree, Node, Node4, PointError, Primitive, Ray, Scalar, F32_COORD_LIMIT,
+    FIXED_COORD_LIMIT, I16F16,
 };
+use raykernel_testkit::memory::OwnedMemory;
 use std::fmt;
 use std::ops::{Add, Mul, Sub};
 
@@ -282,6 +284,34 @@ where
         );
     }
     f(&tree)
+}
+
+/// Builds `kind` over `prims` through [`AnyAccel::build`] into exactly
+/// [`AccelKind::memory_needed`], checks `validate()` (and a kd-tree's depth limit), and hands
+/// it to `f`.
+pub fn with_accel<S, P, R>(
+    kind: AccelKind,
+    prims: &[P],
+    f: impl FnOnce(&AnyAccel<'_, S, P>) -> R,
+) -> R
+where
+    S: Scalar,
+    P: Primitive<S>,
+{
+    let mut arena = OwnedMemory::<S>::for_kind(kind, prims);
+    let accel = AnyAccel::build(kind, prims, &mut arena.memory())
+        .unwrap_or_else(|e| panic!("{} build {kind} ({} prims): {e}", S::NAME, prims.len()));
+    accel
+        .validate()
+        .unwrap_or_else(|e| panic!("{} {kind}: {e}", S::NAME));
+    if let AccelKind::KdTree(o) = kind {
+        assert!(
+            o.max_depth == 0 || accel.depth() <= o.max_depth,
+            "{} {kind} too deep",
+            S::NAME
+        );
+    }
+    f(&accel)
 }
 
 /// Every (builder, leaf size) combination the differential tests cover, each with
