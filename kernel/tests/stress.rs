@@ -11,7 +11,7 @@
 
 mod common;
 
-use common::TestScalar;
+use common::{hit_bits, TestScalar};
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::spawn::{offset_origin, spawn_ray, spawn_shadow_ray, SpawnScalar};
 use raykernel::{
@@ -541,10 +541,6 @@ impl<'a, S: Mode> Accels<'a, S> {
     }
 }
 
-fn bits<S: TestScalar>(h: &Option<Hit<S>>) -> Option<(u32, u32, u32, u32)> {
-    common::hit_bits(h)
-}
-
 /// The closest hit and the any-hit answer of one ray, through whichever structure it visits.
 struct Query<'r, S: Scalar>(&'r Ray<S>);
 
@@ -561,9 +557,9 @@ fn trace<S: Mode>(a: &Accels<S>, ray: &Ray<S>, index: usize) -> (Option<Hit<S>>,
     let (first, answer) = &a.built[0];
     let (h, occluded) = answer.visit(Query(ray));
     let mut bad = None;
-    let want = bits(&h);
+    let want = hit_bits(&h);
     let mut check = |name: &dyn std::fmt::Display, (got, occ): (Option<Hit<S>>, bool)| {
-        if bits(&got) != want || occ != got.is_some() {
+        if hit_bits(&got) != want || occ != got.is_some() {
             bad.get_or_insert_with(|| {
                 format!("{name}: {got:?} (occluded {occ}) vs {first} {h:?}, ray {ray:?}")
             });

@@ -8,6 +8,7 @@ use raykernel::{
     KdNode, KdTree, Node, Node4, PointError, Primitive, Ray, Scalar, F32_COORD_LIMIT,
     FIXED_COORD_LIMIT, I16F16,
 };
+pub use raykernel_testkit::golden::Bits;
 use raykernel_testkit::memory::OwnedMemory;
 use std::fmt;
 use std::ops::{Add, Mul, Sub};
@@ -15,13 +16,12 @@ use std::ops::{Add, Mul, Sub};
 /// Leaf sizes every differential test builds with.
 pub const LEAF_SIZES: [u32; 4] = [1, 2, 4, 8];
 
-/// What the suites need from a number mode beyond [`Scalar`]: exact bits, arithmetic for
-/// computing targets in the mode itself, tolerances and per-mode bad inputs.
+/// What the suites need from a number mode beyond [`Scalar`]: exact bits ([`Bits`], so `-0`
+/// and `+0` differ), arithmetic for computing targets in the mode itself, tolerances and
+/// per-mode bad inputs.
 pub trait TestScalar:
-    Scalar + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self>
+    Scalar + Bits + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self>
 {
-    /// The exact bits (`f32::to_bits`, so `-0` and `+0` differ; raw `i32` for fixed point).
-    fn bits(self) -> u32;
     /// Absolute tolerance for comparing a result of this mode with an `f64` reference of
     /// magnitude `exact` (the reference is computed from the same, already rounded, inputs).
     fn tol(exact: f64) -> f64;
@@ -32,9 +32,6 @@ pub trait TestScalar:
 }
 
 impl TestScalar for f32 {
-    fn bits(self) -> u32 {
-        self.to_bits()
-    }
     fn tol(exact: f64) -> f64 {
         1e-5 * exact.abs().max(1.0)
     }
@@ -58,9 +55,6 @@ impl TestScalar for f32 {
 }
 
 impl TestScalar for I16F16 {
-    fn bits(self) -> u32 {
-        self.raw() as u32
-    }
     fn tol(exact: f64) -> f64 {
         // Q16.16 coordinates and distances (resolution 2^-16), Q2.30 directions; the slab test
         // pads by 2 raw units plus one raw unit of origin shift divided by a direction component.
