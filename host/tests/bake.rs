@@ -134,9 +134,10 @@ fn baked_files_trace_like_the_built_trees_on_suzanne() {
     check_scene(&obj, &rays, &dir);
 }
 
-/// The on-target test's input: an undistorted icosphere (level 2, 320 triangles, radius 1.2)
-/// baked as an f32 4-wide BVH, and its grid hash. Both files are rewritten with `BLESS=1`;
-/// otherwise they must equal what `raykernel bake` writes now.
+/// The on-target inputs: an undistorted icosphere (level 2, 320 triangles, radius 1.2) baked
+/// as an f32 4-wide BVH (the on-target test) and as an f32 binary BVH (the `traverse_baked`
+/// size probe), and their grid hash, which both trees give. The files are rewritten with
+/// `BLESS=1`; otherwise they must equal what `raykernel bake` writes now.
 #[test]
 fn on_target_baked_mesh_is_what_host_bake_writes() {
     let dir = temp_dir("bake-golden");
@@ -150,34 +151,42 @@ fn on_target_baked_mesh_is_what_host_bake_writes() {
     }
     let obj = dir.join("ico.obj");
     std::fs::write(&obj, text).unwrap();
-    let out = dir.join("ico.bvh4");
-    let report = run_bake(&BakeArgs {
-        scene: obj,
-        out: out.clone(),
-        accel: BakeAccel::Bvh4,
-        mode: Mode::F32,
-        builder: Builder::Sah,
-        leaf: DEFAULT_LEAF_SIZE,
-        leaf_order: false,
-    })
-    .unwrap();
     let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/golden");
-    let (file, hash) = (
-        golden.join("baked_ico.bvh4"),
-        golden.join("baked_ico.grid_hash"),
-    );
-    let bytes = std::fs::read(&out).unwrap();
-    if std::env::var_os("BLESS").is_some() {
-        std::fs::write(&file, &bytes).unwrap();
-        std::fs::write(&hash, format!("{}\n", report.grid_hash)).unwrap();
+    let hash = golden.join("baked_ico.grid_hash");
+    for (accel, name) in [
+        (BakeAccel::Bvh4, "baked_ico.bvh4"),
+        (BakeAccel::Bvh, "baked_ico.bvh"),
+    ] {
+        let out = dir.join(name);
+        let report = run_bake(&BakeArgs {
+            scene: obj.clone(),
+            out: out.clone(),
+            accel,
+            mode: Mode::F32,
+            builder: Builder::Sah,
+            leaf: DEFAULT_LEAF_SIZE,
+            leaf_order: false,
+        })
+        .unwrap();
+        let file = golden.join(name);
+        let bytes = std::fs::read(&out).unwrap();
+        if std::env::var_os("BLESS").is_some() {
+            std::fs::write(&file, &bytes).unwrap();
+            std::fs::write(&hash, format!("{}\n", report.grid_hash)).unwrap();
+        }
+        assert!(
+            std::fs::read(&file).unwrap_or_default() == bytes,
+            "{} is stale: BLESS=1 cargo test -p raykernel-host --test bake",
+            file.display()
+        );
+        let committed = std::fs::read_to_string(&hash).unwrap_or_default();
+        assert_eq!(
+            committed.trim(),
+            report.grid_hash,
+            "{} ({name})",
+            hash.display()
+        );
     }
-    assert!(
-        std::fs::read(&file).unwrap_or_default() == bytes,
-        "{} is stale: BLESS=1 cargo test -p raykernel-host --test bake",
-        file.display()
-    );
-    let committed = std::fs::read_to_string(&hash).unwrap_or_default();
-    assert_eq!(committed.trim(), report.grid_hash, "{}", hash.display());
 }
 
 /// The committed baked file, loaded in place as the firmware loads it, gives the committed

@@ -62,8 +62,9 @@ pub use scalar::{PointError, RayError, Scalar, Vec3x, F32_COORD_LIMIT, FIXED_COO
 /// Settings, memory sizes and limits of the binary BVH, [`Bvh`].
 pub mod bvh {
     pub use crate::accel::bvh::{
-        nodes_needed, BuildOptions, BuilderKind, InvalidTree, RefitError, TreeShape, TreeStats,
-        DEFAULT_LEAF_SIZE, MAX_DEPTH, MAX_LEAF_SIZE, MEDIAN_FALLBACK_DEPTH,
+        nodes_needed, BuildOptions, BuildSettings, BuilderKind, InvalidTree, Median, Midpoint,
+        RefitError, Sah, SplitRule, StaticBuild, TreeShape, TreeStats, DEFAULT_LEAF_SIZE,
+        MAX_DEPTH, MAX_LEAF_SIZE, MEDIAN_FALLBACK_DEPTH,
     };
 }
 

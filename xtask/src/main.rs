@@ -3,7 +3,8 @@
 //! - `cargo xtask qemu`: the on-target tests (`tests/qemu`, defmt-test under QEMU) on the
 //!   Cortex-M4F, M3 and M0, the embedded example of docs/EMBEDDED.md on all three, and the
 //!   panic-freedom link check; prints a per-target summary and a final `N passed, M failed`
-//!   line.
+//!   line. `--skip-suites` leaves out the on-target tests (for CI, where `cargo xtask
+//!   determinism` runs the same suites).
 //! - `cargo xtask panic-check`: only the panic-freedom link check (release, all three targets);
 //!   on failure, lists the kernel source lines that still reach a panic.
 //! - `cargo xtask size`: the footprint of the size probes on the three thumb targets (`.text`,
@@ -66,7 +67,14 @@ fn machine_options(target: &str) -> &'static [&'static str] {
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let ok = match args.first().map(String::as_str) {
-        Some("qemu") => qemu(),
+        Some("qemu") => match args.get(1).map(String::as_str) {
+            None => qemu(true),
+            Some("--skip-suites") => qemu(false),
+            Some(other) => {
+                eprintln!("xtask qemu: unknown option `{other}` (the only one: --skip-suites)");
+                false
+            }
+        },
         Some("panic-check") => {
             let r = panic_check();
             println!("{} passed, {} failed", r.0, r.1);
@@ -177,10 +185,11 @@ fn elf(target: &str, profile: &str, bin: &str) -> PathBuf {
     qemu_dir().join(format!("target/{target}/{profile}/{bin}"))
 }
 
-fn qemu() -> bool {
+/// `cargo xtask qemu`; `suites: false` leaves out the on-target test suites.
+fn qemu(suites: bool) -> bool {
     let (mut passed, mut failed) = (0usize, 0usize);
     let mut summary = Vec::new();
-    for (target, core, machine, cpu) in TARGETS {
+    for (target, core, machine, _) in TARGETS.into_iter().filter(|_| suites) {
         println!("\n=== on-target tests: {core} ({target}, QEMU {machine}) ===");
         let (ok, out) = run(cargo(&["test", "--target", target]));
         let (last, total, finished) = progress(&out);
@@ -198,7 +207,8 @@ fn qemu() -> bool {
             "{core:<11} {target:<22} tests ({p}/{total}) {}",
             if ok { "pass" } else { "FAIL" }
         ));
-
+    }
+    for (target, core, machine, cpu) in TARGETS {
         println!("\n=== embedded example: {core} ===");
         let built = run(cargo(&[
             "build",

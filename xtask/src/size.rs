@@ -27,7 +27,7 @@ struct Probe {
     what: &'static str,
 }
 
-const PROBES: [Probe; 2] = [
+const PROBES: [Probe; 3] = [
     Probe {
         name: "build_traverse",
         bin: "size_probe",
@@ -37,6 +37,11 @@ const PROBES: [Probe; 2] = [
         name: "render_bvh",
         bin: "size_probe_render",
         what: "the default scene in f32, a BVH per object: scene conversion, `Renderer::new`, one row of sRGB pixels (arrays on the stack)",
+    },
+    Probe {
+        name: "traverse_baked",
+        bin: "size_probe_baked",
+        what: "an f32 binary BVH baked on the host (`tests/golden/baked_ico.bvh`, 320 triangles, its bytes in `.rodata`) loaded in place with every check, then closest-hit and any-hit queries; no builder",
     },
 ];
 

@@ -19,9 +19,12 @@ impl<S: Scalar> Ray<S> {
     /// # Errors
     /// [`RayError::Origin`] for a non-finite or out-of-range origin, [`RayError::ZeroDirection`]
     /// and [`RayError::NonFiniteDirection`] for an unusable direction.
-    // Always inlined, like the per-mode constructors under it: a ray returned through memory
-    // and then moved stalls its first reader on store forwarding (see `ray_data` for `f32`).
+    // Hosted targets: always inlined, like the per-mode constructors under it, since a ray
+    // returned through memory and then moved stalls its first reader on store forwarding (see
+    // `ray_data` for `f32`). Bare-metal targets: one copy out of line, which builds the
+    // per-mode data in place; inlined, each call site moved the returned data with a memcpy.
     #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline(never))]
     pub fn new(origin: S::Vec3, dir: S::Vec3) -> Result<Self, RayError> {
         let data = S::ray_data(S::vec_to_array(origin), S::vec_to_array(dir))?;
         Ok(Self {
@@ -36,7 +39,9 @@ impl<S: Scalar> Ray<S> {
     ///
     /// # Errors
     /// As [`Ray::new`], plus [`RayError::InvalidInterval`].
+    // Inlined or not as `Ray::new` is, for the same reasons.
     #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline(never))]
     pub fn from_f32(
         origin: [f32; 3],
         dir: [f32; 3],

@@ -4,10 +4,14 @@
 //! Rounding rules: only `+ - * /` and `libm::sqrtf` (correctly rounded everywhere), no fused
 //! multiply-add, min/max as explicit comparisons. Every function is a pure function of its
 //! inputs, so a primitive gives the same bits whichever accelerator asks. No `f64` on any path
-//! of this mode (the exact parts use error-free `f32` transformations, `float/eft.rs`), so a
-//! core with a single-precision FPU links no soft-float; `unit_dir_f64` serves fixed point only.
+//! of this mode on bare-metal targets (the exact parts use error-free `f32` transformations,
+//! `float/eft.rs`), so a core with a single-precision FPU links no soft-float; hosted targets
+//! may shortcut the exact distance through `f64` where a certificate shows the same bits
+//! (`float/rounded.rs`); `unit_dir_f64` serves fixed point only.
 
 mod eft;
+#[cfg(not(target_os = "none"))]
+mod rounded;
 
 use super::lanes::F4;
 use super::Scalar;
@@ -301,7 +305,11 @@ impl FloatRay {
     /// the binade 2^60 ([`scale_to_2_60`], so the exact products do not underflow), and U, V,
     /// W by `det`'s binade so that `det` lies in the binade 2^60 (so `num` cannot overflow, nor
     /// small weights underflow). `None` if `det` is zero.
-    #[inline(always)]
+    ///
+    /// Inlined on hosted targets (speed); bare-metal targets keep one copy for the distance
+    /// and the barycentrics (flash).
+    #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline(never))]
     fn scaled(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> Option<([Df; 3], Df, Df)> {
         let mut m = 0.0f32;
         for p in [a, b, c] {
@@ -340,9 +348,20 @@ impl FloatRay {
     }
 
     /// The distance of [`FloatRay::solve`] alone, out of line: the rare path of every
-    /// triangle test, kept out of the traversal loops.
+    /// triangle test, kept out of the traversal loops. Hosted targets first try the same
+    /// `f32` through `f64` ([`rounded::certified_t`]).
     #[inline(never)]
     fn candidate_t(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> Option<f32> {
+        #[cfg(not(target_os = "none"))]
+        if let Some(t) = rounded::certified_t(a, b, c) {
+            return Some(t);
+        }
+        Self::solved_t(a, b, c)
+    }
+
+    /// The distance of [`FloatRay::solve`] alone, always by the double-`f32` solve.
+    #[inline(always)]
+    fn solved_t(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> Option<f32> {
         let (_, det, num) = Self::scaled(a, b, c)?;
         Some(num.div(det))
     }
@@ -746,6 +765,66 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Sheared triangles around the +z axis (the ray), of every shape a distance solve meets:
+    /// well conditioned, slivers (nearly collinear), tiny, huge, far away, behind the origin,
+    /// at mixed depths, and on exactly representable depths.
+    fn candidates(count: usize) -> impl Iterator<Item = [[f32; 3]; 3]> {
+        let mut state = 0x0f11_7e12_0000_0001u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        (0..count).map(move |i| {
+            let mut unit = || (next() >> 40) as f32 / 16_777_216.0 * 2.0 - 1.0;
+            let scale = libm::exp2f((i % 61) as f32 - 30.0);
+            let depth = libm::exp2f((i % 23) as f32 - 8.0) * if i % 5 == 0 { -1.0 } else { 1.0 };
+            let mut v = [[0.0f32; 3]; 3];
+            for p in &mut v {
+                let z = if i % 7 == 3 {
+                    depth
+                } else {
+                    depth * (1.0 + 0.5 * unit())
+                };
+                *p = [unit() * scale, unit() * scale, z];
+            }
+            if i % 3 == 1 {
+                // A sliver: the third vertex nearly on the line through the first two.
+                let f = 0.5 + 0.25 * unit();
+                let (p0, p1) = (v[0], v[1]);
+                for ((x, a), b) in v[2].iter_mut().zip(p0).zip(p1).take(2) {
+                    *x = a + f * (b - a) + unit() * scale * 1e-6;
+                }
+            }
+            v
+        })
+    }
+
+    #[cfg(not(target_os = "none"))]
+    #[test]
+    fn the_certified_distance_is_the_double_f32_solve_bit_for_bit() {
+        let (mut solved, mut certified) = (0usize, 0usize);
+        for [a, b, c] in candidates(1_000_000) {
+            let exact = FloatRay::solved_t(&a, &b, &c);
+            solved += usize::from(exact.is_some());
+            if let Some(t) = rounded::certified_t(&a, &b, &c) {
+                certified += 1;
+                assert_eq!(
+                    Some(t.to_bits()),
+                    exact.map(f32::to_bits),
+                    "{a:?} {b:?} {c:?}"
+                );
+            }
+        }
+        // The shortcut decides most of them (slivers and triangles the ray misses by far,
+        // whose det cancels, fall back): it is not vacuous.
+        assert!(
+            solved > 500_000 && certified * 2 > solved,
+            "{certified} of {solved} certified"
+        );
     }
 
     #[test]

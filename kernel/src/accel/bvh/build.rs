@@ -4,7 +4,7 @@
 
 use super::select::{select_nth, swap_in};
 use super::{
-    nodes_needed, BuildOptions, BuilderKind, Node, FIRST_PAIR, MAX_DEPTH, MAX_LEAF_SIZE,
+    nodes_needed, BuildSettings, BuilderKind, Node, FIRST_PAIR, MAX_DEPTH, MAX_LEAF_SIZE,
     MEDIAN_FALLBACK_DEPTH,
 };
 use crate::accel::{check_count, check_each, Arena, BuildError};
@@ -19,14 +19,14 @@ const TRAVERSAL_COST: f32 = 1.0;
 
 /// Builds into `nodes`/`ids`: the top-down split, the optional reinsertion pass, then bounds
 /// padded for traversal. Returns (nodes used, depth of the deepest leaf).
-pub(super) fn build<S: Scalar, P: Primitive<S>>(
+pub(super) fn build<S: Scalar, P: Primitive<S>, B: BuildSettings>(
     prims: &[P],
     nodes: &mut [Node<S>],
     ids: &mut [u32],
-    options: BuildOptions,
+    options: B,
 ) -> Result<(usize, u32), BuildError> {
     let (used, mut deepest) = split_top_down(prims, nodes, ids, options)?;
-    if options.reinsertion {
+    if options.reinsertion() {
         let arena = nodes.get_mut(..nodes_needed(prims.len()));
         if let (Some(arena), Some(ids)) = (arena, ids.get_mut(..prims.len())) {
             if let Some(depth) = super::optimize::reinsert(arena, used, ids) {
@@ -43,18 +43,17 @@ pub(super) fn build<S: Scalar, P: Primitive<S>>(
 }
 
 /// The top-down build into `nodes`/`ids`, bounds unpadded.
-fn split_top_down<S: Scalar, P: Primitive<S>>(
+fn split_top_down<S: Scalar, P: Primitive<S>, B: BuildSettings>(
     prims: &[P],
     nodes: &mut [Node<S>],
     ids: &mut [u32],
-    options: BuildOptions,
+    options: B,
 ) -> Result<(usize, u32), BuildError> {
     let n = prims.len();
     check_count(n)?;
-    if options.max_leaf_size == 0 || options.max_leaf_size > MAX_LEAF_SIZE {
-        return Err(BuildError::BadLeafSize {
-            max_leaf_size: options.max_leaf_size,
-        });
+    let max_leaf_size = options.max_leaf_size();
+    if max_leaf_size == 0 || max_leaf_size > MAX_LEAF_SIZE {
+        return Err(BuildError::BadLeafSize { max_leaf_size });
     }
     let needed = nodes_needed(n);
     if nodes.len() < needed {
@@ -87,8 +86,8 @@ fn split_top_down<S: Scalar, P: Primitive<S>>(
     }
     let builder = Builder {
         prims,
-        max_leaf: options.max_leaf_size as usize,
-        kind: options.builder,
+        max_leaf: max_leaf_size as usize,
+        settings: options,
         _scalar: core::marker::PhantomData,
     };
     // Bounds cache: while it is valid, slot `n + pos` of the arena holds the bounds and id of
@@ -326,10 +325,11 @@ impl<S: Scalar> Side<S> {
     }
 }
 
-struct Builder<'p, S, P> {
+struct Builder<'p, S, P, B> {
     prims: &'p [P],
     max_leaf: usize,
-    kind: BuilderKind,
+    /// Read for the split rule only: a constant for a [`super::StaticBuild`].
+    settings: B,
     _scalar: core::marker::PhantomData<S>,
 }
 
@@ -408,7 +408,7 @@ impl<S: Scalar> Slot<S> for Node<S> {
     }
 }
 
-impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
+impl<S: Scalar, P: Primitive<S>, B: BuildSettings> Builder<'_, S, P, B> {
     fn prim(&self, id: u32) -> Aabb<S> {
         match self.prims.get(id as usize) {
             Some(p) => p.bounds(),
@@ -473,7 +473,7 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
         if depth >= MEDIAN_FALLBACK_DEPTH {
             return must_split.then(|| self.median(ids, widest));
         }
-        match self.kind {
+        match self.settings.builder() {
             BuilderKind::Median => must_split.then(|| self.median(ids, widest)),
             BuilderKind::Midpoint => must_split.then(|| {
                 let mid = clo[widest] * 0.5 + chi[widest] * 0.5;
@@ -564,7 +564,7 @@ impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
     }
 }
 
-impl<S: Scalar, P: Primitive<S>> Builder<'_, S, P> {
+impl<S: Scalar, P: Primitive<S>, B: BuildSettings> Builder<'_, S, P, B> {
     /// [`Builder::sah`] for two primitives with boxes `p`, `q`: the axis to split on, or `None`
     /// for a leaf (or no axis separating the centroids).
     ///

@@ -130,6 +130,103 @@ impl Default for BuildOptions {
     }
 }
 
+/// What a build is told: chosen at run time ([`BuildOptions`]) or named at compile time
+/// ([`StaticBuild`]). Every build runs the same generic code; with a [`StaticBuild`] the choice
+/// is a constant, so the split rules and passes it does not name are not linked.
+pub trait BuildSettings: Copy {
+    /// The split rule.
+    fn builder(self) -> BuilderKind;
+    /// No leaf holds more primitives than this (1..=[`MAX_LEAF_SIZE`]).
+    fn max_leaf_size(self) -> u32;
+    /// Whether the reinsertion pass runs (see [`BuildOptions::reinsertion`]).
+    fn reinsertion(self) -> bool;
+}
+
+impl BuildSettings for BuildOptions {
+    #[inline(always)]
+    fn builder(self) -> BuilderKind {
+        self.builder
+    }
+    #[inline(always)]
+    fn max_leaf_size(self) -> u32 {
+        self.max_leaf_size
+    }
+    #[inline(always)]
+    fn reinsertion(self) -> bool {
+        self.reinsertion
+    }
+}
+
+/// A split rule named as a type, for [`StaticBuild`].
+pub trait SplitRule: Copy {
+    /// The rule.
+    const KIND: BuilderKind;
+}
+
+/// [`BuilderKind::Sah`] as a type.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Sah;
+/// [`BuilderKind::Median`] as a type.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Median;
+/// [`BuilderKind::Midpoint`] as a type.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Midpoint;
+
+impl SplitRule for Sah {
+    const KIND: BuilderKind = BuilderKind::Sah;
+}
+impl SplitRule for Median {
+    const KIND: BuilderKind = BuilderKind::Median;
+}
+impl SplitRule for Midpoint {
+    const KIND: BuilderKind = BuilderKind::Midpoint;
+}
+
+/// Build settings fixed at compile time: the split rule `R`, the reinsertion pass if and only
+/// if `REINSERT`; only the leaf size is a value. A build with `StaticBuild::<Sah, false>` links
+/// the SAH builder and nothing of the other rules or the reinsertion pass. Gives the same tree
+/// as the [`BuildOptions`] with the same three choices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct StaticBuild<R: SplitRule, const REINSERT: bool> {
+    /// As [`BuildOptions::max_leaf_size`].
+    pub max_leaf_size: u32,
+    rule: PhantomData<R>,
+}
+
+impl<R: SplitRule, const REINSERT: bool> StaticBuild<R, REINSERT> {
+    /// The settings with leaves of up to `max_leaf_size` primitives.
+    #[must_use]
+    pub const fn new(max_leaf_size: u32) -> Self {
+        Self {
+            max_leaf_size,
+            rule: PhantomData,
+        }
+    }
+}
+
+impl<R: SplitRule, const REINSERT: bool> Default for StaticBuild<R, REINSERT> {
+    /// Leaves of up to [`DEFAULT_LEAF_SIZE`].
+    fn default() -> Self {
+        Self::new(DEFAULT_LEAF_SIZE)
+    }
+}
+
+impl<R: SplitRule, const REINSERT: bool> BuildSettings for StaticBuild<R, REINSERT> {
+    #[inline(always)]
+    fn builder(self) -> BuilderKind {
+        R::KIND
+    }
+    #[inline(always)]
+    fn max_leaf_size(self) -> u32 {
+        self.max_leaf_size
+    }
+    #[inline(always)]
+    fn reinsertion(self) -> bool {
+        REINSERT
+    }
+}
+
 /// A built BVH, borrowing its nodes, primitive ids and primitives.
 #[derive(Clone, Copy, Debug)]
 pub struct Bvh<'a, S: Scalar, P: Primitive<S>> {
@@ -152,11 +249,11 @@ impl<'a, S: Scalar, P: Primitive<S>> Bvh<'a, S, P> {
     /// [`BuildError::ArenaTooSmall`] with exact sizes, [`BuildError::TooManyPrims`],
     /// [`BuildError::BadPrimitive`] for the first non-finite or out-of-range vertex, and
     /// [`BuildError::BadLeafSize`].
-    pub fn build(
+    pub fn build<B: BuildSettings>(
         prims: &'a [P],
         nodes: &'a mut [Node<S>],
         prim_ids: &'a mut [u32],
-        options: BuildOptions,
+        options: B,
     ) -> Result<Self, BuildError> {
         let (node_count, depth) = build::build(prims, nodes, prim_ids, options)?;
         let nodes: &'a [Node<S>] = nodes;
@@ -178,11 +275,11 @@ impl<'a, S: Scalar, P: Primitive<S>> Bvh<'a, S, P> {
     ///
     /// # Errors
     /// As [`Bvh::build`].
-    pub fn build_in_leaf_order(
+    pub fn build_in_leaf_order<B: BuildSettings>(
         prims: &'a mut [P],
         nodes: &'a mut [Node<S>],
         prim_ids: &'a mut [u32],
-        options: BuildOptions,
+        options: B,
     ) -> Result<Self, BuildError>
     where
         P: Copy,

@@ -6,18 +6,16 @@ use crate::geom::{closer, Primitive, Ray};
 use crate::scalar::Scalar;
 
 impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
-    /// Walks the tree. With `ANY`, returns at the first hit in range; otherwise finds the
+    /// Walks the tree. With `any`, returns at the first hit in range; otherwise finds the
     /// closest under [`closer`]. Returns (t, prim id, index into `prims`) of the hit;
     /// `prim id == u32::MAX` for none.
     ///
     /// Not inlined: every caller (renderer, host, benchmarks) runs the same machine code, so
-    /// their timings differ only by what they do around the walk.
+    /// their timings differ only by what they do around the walk. `any` is an argument, not a
+    /// type parameter, so closest and any hit share that code (one copy in flash): it is
+    /// read only when a primitive is hit.
     #[inline(never)]
-    fn traverse<const ANY: bool, C: Counters>(
-        &self,
-        ray: &Ray<S>,
-        stats: &mut C,
-    ) -> (S, u32, usize) {
+    fn traverse<C: Counters>(&self, ray: &Ray<S>, stats: &mut C, any: bool) -> (S, u32, usize) {
         let rd = ray.data();
         let t_min = ray.t_min();
         // (t, prim id, index into `prims`) of the best hit so far.
@@ -37,7 +35,7 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
         'walk: loop {
             if node.count > 0 {
                 let leaf = (node.first as usize, node.count as usize);
-                if test_leaf::<ANY, S, P, C>(self.leaf(), leaf, rd, t_min, &mut best, stats) {
+                if test_leaf(self.leaf(), leaf, rd, t_min, &mut best, stats, any) {
                     return best;
                 }
             } else {
@@ -97,15 +95,16 @@ pub(crate) type LeafPrims<'a, P> = (&'a [u32], &'a [P], bool);
 
 /// The leaf loop of both BVH traversals (binary and 4-wide): tests the primitives with the ids
 /// `prim_ids[first..first + count]`, keeping in `best` (t, prim id, index into `prims`) the
-/// closest hit under [`closer`]. With `ANY`, stores the first hit in range and returns true.
+/// closest hit under [`closer`]. With `any`, stores the first hit in range and returns true.
 #[inline(always)]
-pub(crate) fn test_leaf<const ANY: bool, S: Scalar, P: Primitive<S>, C: Counters>(
+pub(crate) fn test_leaf<S: Scalar, P: Primitive<S>, C: Counters>(
     (prim_ids, prims, leaf_order): LeafPrims<'_, P>,
     (first, count): (usize, usize),
     rd: &S::RayData,
     t_min: S,
     best: &mut (S, u32, usize),
     stats: &mut C,
+    any: bool,
 ) -> bool {
     let ids = prim_ids
         .get(first..first.saturating_add(count))
@@ -117,7 +116,7 @@ pub(crate) fn test_leaf<const ANY: bool, S: Scalar, P: Primitive<S>, C: Counters
         };
         stats.prim();
         if let Some(t) = prim.hit_t(rd, t_min, best.0) {
-            if ANY {
+            if any {
                 *best = (t, id, at);
                 return true;
             }
@@ -132,7 +131,7 @@ pub(crate) fn test_leaf<const ANY: bool, S: Scalar, P: Primitive<S>, C: Counters
 impl<S: Scalar, P: Primitive<S>> Accel<S> for Bvh<'_, S, P> {
     #[inline]
     fn nearest_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Nearest<S>> {
-        let (t, prim, slot) = self.traverse::<false, C>(ray, stats);
+        let (t, prim, slot) = self.traverse(ray, stats, false);
         Nearest::found(t, prim, slot)
     }
 
@@ -142,6 +141,6 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for Bvh<'_, S, P> {
 
     #[inline]
     fn occluded_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> bool {
-        self.traverse::<true, C>(ray, stats).1 != u32::MAX
+        self.traverse(ray, stats, true).1 != u32::MAX
     }
 }

@@ -145,7 +145,7 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                 }
             } else {
                 let leaf = (child as usize, count as usize);
-                if test_leaf::<ANY, S, P, C>(self.leaf(), leaf, rd, t_min, &mut best, stats) {
+                if test_leaf(self.leaf(), leaf, rd, t_min, &mut best, stats, ANY) {
                     return best;
                 }
             }

@@ -1,4 +1,4 @@
-//! Size probe `build_traverse`: an `f32` SAH BVH built over a small generated mesh, then
+//! Size probe `build_traverse`: an `f32` SAH BVH (no reinsertion) built over a small generated mesh, then
 //! closest-hit and any-hit queries; nothing else (no defmt, a spinning panic handler).
 //! `cargo xtask size` reports its `.text`/`.rodata` and runs it under QEMU to measure its stack:
 //! the only measuring code is the store to [`PROBE_DONE`] once the workload has run.
@@ -8,7 +8,7 @@
 use core::hint::black_box;
 use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m_rt::entry;
-use raykernel::bvh::{nodes_needed, BuildOptions};
+use raykernel::bvh::{nodes_needed, Sah, StaticBuild};
 use raykernel::{Accel, Bvh, Node, Ray, Triangle};
 
 /// Cells per side of the generated heightfield; two triangles per cell.
@@ -35,7 +35,8 @@ fn build_and_trace() {
     }
     let mut nodes = [Node::<f32>::EMPTY; nodes_needed(N)];
     let mut ids = [0u32; N];
-    let options = black_box(BuildOptions::default());
+    // SAH without the reinsertion pass, named at compile time: no other builder linked.
+    let options = black_box(StaticBuild::<Sah, false>::default());
     let Ok(bvh) = Bvh::build(&tris, &mut nodes, &mut ids, options) else {
         return;
     };

@@ -1,0 +1,55 @@
+//! Hosted targets' shortcut to a candidate's distance: the `f32` the double-`f32` solve
+//! returns, computed in `f64` (hardware there) and certified, else `None` and the caller runs
+//! that solve. Bare-metal targets (`target_os = "none"`) do not compile this file: they always
+//! run the solve, and link no `f64`.
+//!
+//! Why the two agree. Let `t = num / det` be the exact distance of the sheared vertices (edge
+//! functions `U, V, W`, `det = U + V + W`, `num = U·az + V·bz + W·cz`), `S = |U| + |V| + |W|`
+//! and `Z = |U·az| + |V·bz| + |W·cz|`, and `K = 1 + Z / |num| + S / |det|`.
+//! - The double-`f32` solve (`FloatRay::scaled`, `Df::div`) keeps each edge function within
+//!   `2^-44` of its value, `det` within `2^-45·S`, `num` within `2^-43·Z` (exact power-of-two
+//!   scalings aside); its quotient, before the final rounding to `f32`, is within about
+//!   `2^-42·K` of `t`, relatively. A rounding to nearest then gives the `f32` nearest to `t`
+//!   unless a midpoint between two `f32`s lies within that error of `t`.
+//! - Here every product of two `f32` is exact in `f64`, so each edge function rounds once
+//!   (`2^-53`), `det` and `num` carry at most `2^-52·S` and `2^-51·Z`, and the quotient is
+//!   within `2^-50·K` of `t`.
+//! - The result is accepted only if the interval of relative half-width `2^-32·K` around the
+//!   `f64` quotient (over `2^9` times both errors) holds no midpoint: then both give the `f32`
+//!   nearest to `t`. Also refused: `det` within `2^-20·S` of zero (so neither solve divides by
+//!   a cancelled value), a zero or non-finite result (signs of zeros, overflow).
+
+const CONDITION: f64 = 1.0 / 1_048_576.0; // 2^-20
+const RELATIVE: f64 = 1.0 / 4_294_967_296.0; // 2^-32
+
+/// The double-`f32` solve's distance for the sheared vertices `a`, `b`, `c`, if the `f64`
+/// evaluation can certify it (see the module docs).
+#[inline(always)]
+pub(super) fn certified_t(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> Option<f32> {
+    let wide = |p: &[f32; 3]| [f64::from(p[0]), f64::from(p[1]), f64::from(p[2])];
+    let (a, b, c) = (wide(a), wide(b), wide(c));
+    let edge = |p: &[f64; 3], q: &[f64; 3]| p[0] * q[1] - p[1] * q[0];
+    let (u, v, w) = (edge(&c, &b), edge(&a, &c), edge(&b, &a));
+    let det = u + v + w;
+    let (nu, nv, nw) = (u * a[2], v * b[2], w * c[2]);
+    let num = nu + nv + nw;
+    let s = u.abs() + v.abs() + w.abs();
+    let z = nu.abs() + nv.abs() + nw.abs();
+    if !(det.abs() > s * CONDITION && num != 0.0) {
+        return None;
+    }
+    let t = num / det;
+    let t32 = t as f32;
+    if t32 == 0.0 || !t32.is_finite() {
+        return None;
+    }
+    let bound = t.abs() * RELATIVE * (1.0 + z / num.abs() + s / det.abs());
+    // The midpoints towards both neighbours (`bits - 1` is nearer zero, `bits + 1` farther;
+    // an infinite neighbour only makes that half-gap infinite).
+    let bits = t32.to_bits();
+    let at = f64::from(t32);
+    let nearer = (at - f64::from(f32::from_bits(bits - 1))).abs();
+    let farther = (f64::from(f32::from_bits(bits + 1)) - at).abs();
+    let half_gap = nearer.min(farther) * 0.5;
+    ((t - at).abs() + bound < half_gap).then_some(t32)
+}
