@@ -12,7 +12,7 @@
 use crate::error::Error;
 use crate::ours::mrays;
 use crate::results::ScaleRow;
-use crate::workload::{incoherent_rays, primary_rays, side_for, SplitMix64};
+use crate::workload::{incoherent_rays, primary_rays, side_for};
 use host::obj::Mesh;
 use host::scene::PinholeCamera;
 use host::trace::{
@@ -21,6 +21,7 @@ use host::trace::{
 };
 use raykernel::bvh::BuildOptions;
 use raykernel::{Accel, AccelKind, AccelVisitor, Scalar, TraversalStats, I16F16};
+use raykernel_testkit::Rng;
 use std::hint::black_box;
 use std::path::Path;
 
@@ -78,13 +79,13 @@ pub fn tiled_scene(meshes: &[&Mesh], target: usize, seed: u64) -> Option<Tiled> 
         return None;
     }
     // Plan: (source, rotation parameter, half-turn flip) per instance.
-    let mut rng = SplitMix64(seed);
+    let mut rng = Rng::new(seed);
     let mut plan = Vec::new();
     let mut total = 0usize;
     while total < target {
-        let m = ((rng.unit() * sources.len() as f64) as usize).min(sources.len() - 1);
-        let t = 2.0 * rng.unit() - 1.0;
-        let flip = rng.unit() < 0.5;
+        let m = ((rng.unit_f64() * sources.len() as f64) as usize).min(sources.len() - 1);
+        let t = 2.0 * rng.unit_f64() - 1.0;
+        let flip = rng.unit_f64() < 0.5;
         plan.push((m, t, flip));
         total += sources[m].mesh.triangles.len();
     }

@@ -5,6 +5,7 @@ use crate::error::Error;
 use host::obj::{load_obj, Mesh};
 use host::rayfile::{read_rays, RayRecord};
 use host::scene::PinholeCamera;
+use raykernel_testkit::Rng;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -40,8 +41,8 @@ pub enum RaySource {
     /// Run `make_rays.py` (beside the scenes, in `../bench/`) into a temporary directory.
     MakeRays,
     /// Generate in Rust, `count` rays per set: primary rays by WORKLOAD.md's camera formula on a
-    /// `⌊√count⌋²` grid, incoherent rays from this module's SplitMix64 (not numpy's PCG64, so not
-    /// the files' rays). For tests and machines without python.
+    /// `⌊√count⌋²` grid, incoherent rays from SplitMix64 (`raykernel_testkit::Rng`; not numpy's
+    /// PCG64, so not the files' rays). For tests and machines without python.
     Rust {
         /// Rays per set.
         count: usize,
@@ -319,12 +320,12 @@ pub fn primary_rays(camera: &PinholeCamera, side: u32) -> Vec<RayRecord> {
 /// (normalised in `f64`, then rounded), from SplitMix64 seeded with `seed`.
 #[must_use]
 pub fn incoherent_rays(lo: [f64; 3], hi: [f64; 3], count: usize, seed: u64) -> Vec<RayRecord> {
-    let mut rng = SplitMix64(seed);
+    let mut rng = Rng::new(seed);
     (0..count)
         .map(|_| {
-            let o: [f64; 3] = std::array::from_fn(|k| lo[k] + rng.unit() * (hi[k] - lo[k]));
-            let z = 1.0 - 2.0 * rng.unit();
-            let phi = 2.0 * std::f64::consts::PI * rng.unit();
+            let o: [f64; 3] = std::array::from_fn(|k| lo[k] + rng.unit_f64() * (hi[k] - lo[k]));
+            let z = 1.0 - 2.0 * rng.unit_f64();
+            let phi = 2.0 * std::f64::consts::PI * rng.unit_f64();
             let s = (1.0 - z * z).max(0.0).sqrt();
             let d = [s * phi.cos(), s * phi.sin(), z];
             let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
@@ -351,23 +352,4 @@ pub fn referenced_bounds(mesh: &Mesh) -> ([f64; 3], [f64; 3]) {
         return ([0.0; 3], [0.0; 3]);
     }
     (lo, hi)
-}
-
-/// SplitMix64 (Steele, Lea, Flood 2014): small, seeded, deterministic on every platform.
-#[derive(Clone, Debug)]
-pub struct SplitMix64(pub u64);
-
-impl SplitMix64 {
-    /// Next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in `[0, 1)`, 53 bits.
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
 }

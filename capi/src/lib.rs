@@ -13,7 +13,7 @@
 
 use core::ffi::{c_char, c_void};
 use core::mem::{align_of, size_of};
-use raykernel::baked::{read_header, BakedMode};
+use raykernel::baked::{read_header, BakedMode, BakedScalar};
 use raykernel::bvh::{nodes_needed, BuildOptions, TreeShape, MAX_LEAF_SIZE};
 use raykernel::bvh4::nodes4_needed;
 use raykernel::{
@@ -104,14 +104,10 @@ pub struct RkHit {
     pub v: f32,
 }
 
-/// One of the four tree types, borrowing caller memory (lifetimes erased: the caller's
-/// contract).
-#[derive(Clone, Copy)]
-enum Tree<S: Scalar> {
-    Bvh(Bvh<'static, S, Triangle<S>>),
-    Bvh4(Bvh4<'static, S, Triangle<S>>),
-}
+/// A tree borrowing caller memory, built or loaded (lifetimes erased: the caller's contract).
+type Tree<S> = Baked<'static, S>;
 
+/// One of the four tree types: a binary or 4-wide BVH in either mode.
 #[derive(Clone, Copy)]
 enum AnyTree {
     F32(Tree<f32>),
@@ -374,7 +370,7 @@ fn convert<S: Scalar>(verts: &[f32], out: &mut [Triangle<S>]) -> Result<(), RkSt
     Ok(())
 }
 
-fn build_in<S: Scalar>(
+fn build_in<S: BakedScalar>(
     verts: &[f32],
     mut arrays: Arrays,
     kind: u32,
@@ -387,11 +383,11 @@ fn build_in<S: Scalar>(
     let bvh = Bvh::build(tris, nodes, ids, options).map_err(|_| RkStatus::ErrTooLarge)?;
     if kind == RK_KIND_BVH {
         arrays.shape = bvh.shape();
-        return Ok((Tree::Bvh(bvh), arrays));
+        return Ok((Baked::Bvh(bvh), arrays));
     }
     let wide = Bvh4::collapse(&bvh, nodes4).map_err(|_| RkStatus::ErrTooLarge)?;
     arrays.shape = wide.shape();
-    Ok((Tree::Bvh4(wide), arrays))
+    Ok((Baked::Bvh4(wide), arrays))
 }
 
 /// Loads baked bytes (`raykernel bake`'s output, e.g. in flash) in place and fills `out`: every
@@ -409,8 +405,8 @@ pub unsafe extern "C" fn rk_load_baked(
     // SAFETY: valid for reads of `len` bytes, unmodified while used (contract).
     let bytes: &'static [u8] = unsafe { core::slice::from_raw_parts(bytes, len) };
     let tree = match read_header(bytes).map(|h| h.mode) {
-        Ok(BakedMode::F32) => Baked::<f32>::load(bytes).map(|b| AnyTree::F32(from_baked(b))),
-        Ok(BakedMode::Fixed) => Baked::<I16F16>::load(bytes).map(|b| AnyTree::Fixed(from_baked(b))),
+        Ok(BakedMode::F32) => Baked::<f32>::load(bytes).map(AnyTree::F32),
+        Ok(BakedMode::Fixed) => Baked::<I16F16>::load(bytes).map(AnyTree::Fixed),
         Err(e) => Err(e),
     };
     match tree {
@@ -426,13 +422,6 @@ pub unsafe extern "C" fn rk_load_baked(
             RkStatus::Ok
         }
         Err(e) => bake_status(e),
-    }
-}
-
-fn from_baked<S: raykernel::baked::BakedScalar>(b: Baked<'static, S>) -> Tree<S> {
-    match b {
-        Baked::Bvh(t) => Tree::Bvh(t),
-        Baked::Bvh4(t) => Tree::Bvh4(t),
     }
 }
 
@@ -488,17 +477,18 @@ pub unsafe extern "C" fn rk_refit(
     }
 }
 
-fn refit_in<S: Scalar>(tree: Tree<S>, verts: &[f32], arrays: &Arrays) -> Result<Tree<S>, RkStatus> {
+fn refit_in<S: BakedScalar>(
+    tree: Tree<S>,
+    verts: &[f32],
+    arrays: &Arrays,
+) -> Result<Tree<S>, RkStatus> {
     // SAFETY: `arrays` came from `rk_build` for this mode; the old tree (which borrows the
     // same memory) is not used again: the caller stores the refitted one in its place.
     let (tris, ids, nodes, nodes4) = unsafe { slices::<S>(arrays) };
     convert(verts, tris)?;
     let (tris, ids): (&'static [Triangle<S>], &'static [u32]) = (tris, ids);
-    let bad = |_| RkStatus::ErrNotRefittable;
-    Ok(match tree {
-        Tree::Bvh(_) => Tree::Bvh(Bvh::refit(tris, nodes, ids, arrays.shape).map_err(bad)?),
-        Tree::Bvh4(_) => Tree::Bvh4(Bvh4::refit(tris, nodes4, ids, arrays.shape).map_err(bad)?),
-    })
+    Baked::refit(tree.kind(), tris, nodes, nodes4, ids, arrays.shape)
+        .map_err(|_| RkStatus::ErrNotRefittable)
 }
 
 fn ray_of<S: Scalar>(r: &RkRay) -> Result<Ray<S>, RkStatus> {
@@ -522,20 +512,14 @@ fn hit_of<S: Scalar>(h: Option<Hit<S>>) -> RkHit {
     )
 }
 
-fn intersect_in<S: Scalar>(tree: &Tree<S>, ray: &RkRay) -> Result<RkHit, RkStatus> {
+fn intersect_in<S: BakedScalar>(tree: &Tree<S>, ray: &RkRay) -> Result<RkHit, RkStatus> {
     let ray = ray_of::<S>(ray)?;
-    Ok(hit_of(match tree {
-        Tree::Bvh(t) => t.intersect(&ray),
-        Tree::Bvh4(t) => t.intersect(&ray),
-    }))
+    Ok(hit_of(tree.intersect(&ray)))
 }
 
-fn occluded_in<S: Scalar>(tree: &Tree<S>, ray: &RkRay) -> Result<bool, RkStatus> {
+fn occluded_in<S: BakedScalar>(tree: &Tree<S>, ray: &RkRay) -> Result<bool, RkStatus> {
     let ray = ray_of::<S>(ray)?;
-    Ok(match tree {
-        Tree::Bvh(t) => t.occluded(&ray),
-        Tree::Bvh4(t) => t.occluded(&ray),
-    })
+    Ok(tree.occluded(&ray))
 }
 
 /// The closest hit of `ray` (ties go to the lowest triangle index), into `hit`

@@ -1,8 +1,9 @@
 //! Arbitrary bytes -> a triangle scene and a few rays, in both number modes.
 //!
-//! Checks, for every builder in `BuilderKind::ALL` and leaf sizes 1, 2, 4, 8 (plus one
-//! leaf-order build): the tree validates, the BVH's closest hit equals brute force (`Linear`) bit
-//! for bit (t bits, prim, u bits, v bits), `occluded() == intersect().is_some()` for both, hits
+//! Checks, for every structure of [`kinds`] (every BVH builder and leaf size, the 4-wide BVH,
+//! the grid and the kd-tree, built through `AnyAccel`; plus one leaf-order build): the structure
+//! validates, its closest hit equals brute force (`Linear`) bit for bit (t bits, prim, u bits,
+//! v bits), `occluded() == intersect().is_some()` for both, hits
 //! lie in the ray's interval with barycentrics in [0, 1]; arenas one slot too small give
 //! `ArenaTooSmall`; bad vertices give `BadPrimitive` (the same one `Triangle::from_f32` names);
 //! spawned rays (`raykernel::spawn`) are valid and never panic. Nothing may panic.
@@ -10,10 +11,14 @@
 
 use libfuzzer_sys::fuzz_target;
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
+use raykernel::grid::GridOptions;
+use raykernel::kdtree::{self, KdOptions};
 use raykernel::spawn::{spawn_ray, SpawnScalar};
 use raykernel::{
-    Accel, Arena, BuildError, Bvh, Hit, Linear, Node, Ray, Triangle, F32_COORD_LIMIT, I16F16,
+    Accel, AccelKind, AnyAccel, Arena, BuildError, Bvh, Hit, Linear, Node, Ray, Triangle,
+    F32_COORD_LIMIT, I16F16,
 };
+use raykernel_testkit::memory::OwnedMemory;
 
 /// Reads the input front to back; past the end everything is zero.
 struct Bytes<'a> {
@@ -314,36 +319,32 @@ fn check_mode<S: Mode>(tris_f32: &[[[f32; 3]; 3]], rays_in: &[RayIn]) {
         })
         .collect();
 
-    let mut builds: Vec<BuildOptions> = Vec::new();
-    for builder in BuilderKind::ALL {
-        for max_leaf_size in [1, 2, 4, 8] {
-            builds.push(BuildOptions {
-                builder,
-                max_leaf_size,
-                reinsertion: true,
-            });
-        }
-    }
-    for options in builds {
-        let mut nodes = vec![Node::<S>::EMPTY; nodes_needed(n)];
-        let mut ids = vec![0u32; n];
-        let bvh = Bvh::build(&tris, &mut nodes, &mut ids, options)
-            .unwrap_or_else(|e| panic!("{} build {options:?}: {e}", S::NAME));
-        if let Err(e) = bvh.validate() {
-            panic!("{} {options:?}: invalid tree: {e:?}", S::NAME);
+    for kind in kinds() {
+        // The grid's size depends on the geometry: its counting pass may refuse a scene with a
+        // typed error. Every other structure's size depends on the count alone.
+        let need = match kind.memory_needed(&tris) {
+            Ok(need) => need,
+            Err(_) if kind.memory_for_count(n).is_none() => continue,
+            Err(e) => panic!("{} {kind}: memory: {e}", S::NAME),
+        };
+        let mut memory = OwnedMemory::<S>::sized(need);
+        let accel = AnyAccel::build(kind, &tris, &mut memory.memory())
+            .unwrap_or_else(|e| panic!("{} build {kind}: {e}", S::NAME));
+        if let Err(e) = accel.validate() {
+            panic!("{} {kind}: invalid: {e:?}", S::NAME);
         }
         for (r, w) in rays.iter().zip(&want) {
-            let got = bvh.intersect(r);
+            let got = accel.intersect(r);
             assert_eq!(
                 bits(&got),
                 bits(w),
-                "{} {options:?}: BVH {got:?} != Linear {w:?}",
+                "{} {kind}: {got:?} != Linear {w:?}",
                 S::NAME
             );
             assert_eq!(
-                bvh.occluded(r),
+                accel.occluded(r),
                 got.is_some(),
-                "{} {options:?}: occluded",
+                "{} {kind}: occluded",
                 S::NAME
             );
         }
@@ -364,6 +365,34 @@ fn check_mode<S: Mode>(tris_f32: &[[[f32; 3]; 3]], rays_in: &[RayIn]) {
         );
         assert_eq!(bvh.occluded(r), got.is_some());
     }
+}
+
+/// Every structure checked against brute force: each BVH builder at leaf sizes 1, 2, 4 and 8,
+/// the 4-wide BVH collapsed from each builder's leaf-4 tree, the grid at three densities and the
+/// kd-tree at the automatic and the deepest depth limit.
+fn kinds() -> Vec<AccelKind> {
+    let mut kinds = Vec::new();
+    for builder in BuilderKind::ALL {
+        for max_leaf_size in [1, 2, 4, 8] {
+            kinds.push(AccelKind::Bvh(BuildOptions {
+                builder,
+                max_leaf_size,
+                reinsertion: true,
+            }));
+        }
+        kinds.push(AccelKind::Bvh4(BuildOptions {
+            builder,
+            max_leaf_size: 4,
+            reinsertion: true,
+        }));
+    }
+    for density in [0.25, GridOptions::DEFAULT.density, 8.0] {
+        kinds.push(AccelKind::Grid(GridOptions { density }));
+    }
+    for max_depth in [0, kdtree::MAX_DEPTH] {
+        kinds.push(AccelKind::KdTree(KdOptions { max_depth }));
+    }
+    kinds
 }
 
 fuzz_target!(|data: &[u8]| {

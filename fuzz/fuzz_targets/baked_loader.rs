@@ -9,12 +9,10 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use raykernel::baked::{
-    bake_bvh, bake_bvh4, baked_len, checksum, BakedKind, BakedScalar, MAX_ALIGN,
-};
-use raykernel::bvh::{nodes_needed, BuildOptions};
-use raykernel::bvh4::nodes4_needed;
-use raykernel::{Accel, Baked, Bvh, Bvh4, Hit, Linear, Node, Node4, Ray, Scalar, Triangle, I16F16};
+use raykernel::baked::{checksum, BakedKind, BakedScalar, MAX_ALIGN};
+use raykernel::bvh::BuildOptions;
+use raykernel::{Accel, AnyAccel, Baked, Hit, Linear, Ray, Scalar, Triangle, I16F16};
+use raykernel_testkit::memory::OwnedMemory;
 
 /// Reads the input front to back; past the end everything is zero.
 struct Bytes<'a> {
@@ -94,10 +92,7 @@ fn run<S: BakedScalar>(ctl: u8, rest: &[u8]) {
     let Ok(tree) = Baked::<S>::load(bytes) else {
         return;
     };
-    let (ids, prims, leaf_order) = match &tree {
-        Baked::Bvh(t) => (t.prim_ids(), t.prims(), t.is_leaf_order()),
-        Baked::Bvh4(t) => (t.prim_ids(), t.prims(), t.is_leaf_order()),
-    };
+    let (ids, prims, leaf_order) = (tree.prim_ids(), tree.prims(), tree.is_leaf_order());
     let mut by_id = prims.to_vec();
     if leaf_order {
         for (slot, &id) in ids.iter().enumerate() {
@@ -152,27 +147,18 @@ fn bake<S: BakedScalar>(
         max_leaf_size: leaf,
         ..BuildOptions::default()
     };
+    let accel = kind.accel(options);
     let mut own = tris.to_vec();
-    let mut nodes = vec![Node::<S>::EMPTY; nodes_needed(tris.len())];
-    let mut ids = vec![0u32; tris.len()];
-    let bvh = if leaf_order {
-        Bvh::build_in_leaf_order(&mut own, &mut nodes, &mut ids, options)
+    let mut arena = OwnedMemory::<S>::sized(accel.memory_needed(tris).ok()?);
+    let mut memory = arena.memory();
+    let built = if leaf_order {
+        AnyAccel::build_in_leaf_order(accel, &mut own, &mut memory)
     } else {
-        Bvh::build(tris, &mut nodes, &mut ids, options)
+        AnyAccel::build(accel, tris, &mut memory)
     }
     .ok()?;
-    match kind {
-        BakedKind::Bvh => {
-            let mut out = vec![0u8; baked_len(kind, bvh.nodes().len(), tris.len())?];
-            bake_bvh(&bvh, &mut out).ok()?;
-            Some(out)
-        }
-        BakedKind::Bvh4 => {
-            let mut nodes4 = vec![Node4::<S>::EMPTY; nodes4_needed(tris.len())];
-            let wide = Bvh4::collapse(&bvh, &mut nodes4).ok()?;
-            let mut out = vec![0u8; baked_len(kind, wide.nodes().len(), tris.len())?];
-            bake_bvh4(&wide, &mut out).ok()?;
-            Some(out)
-        }
-    }
+    let tree = Baked::from_any(built)?;
+    let mut out = vec![0u8; tree.baked_len()?];
+    tree.bake(&mut out).ok()?;
+    Some(out)
 }

@@ -11,20 +11,15 @@ use raykernel::render::{
     Settings, Shape,
 };
 use raykernel::{AccelFamily, AccelMemory, BvhFamily, LinearFamily, Node, Sphere};
+use raykernel_testkit::Rng;
 use std::time::Instant;
 
 const SIZE: u32 = 64;
 
 fn spheres(n: usize) -> Vec<Sphere<f32>> {
-    // SplitMix64, so every run and platform scatters the same spheres.
-    let mut state = 0x5EED_u64;
-    let mut unit = || {
-        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    };
+    // Seeded, so every run and platform scatters the same spheres.
+    let mut rng = Rng::new(0x5EED);
+    let mut unit = || rng.unit();
     let side = (n as f32).cbrt();
     (0..n)
         .map(|_| {

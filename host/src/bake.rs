@@ -5,14 +5,11 @@
 use crate::error::Error;
 use crate::obj::load_obj;
 use crate::rayfile::{read_rays, write_hits, HitRecord, RayRecord};
-use crate::trace::{prepare_rays, trace_closest, Builder, Mode};
+use crate::trace::{prepare_rays, trace_closest, Builder, Mode, NodeArena};
 use clap::Args;
-use raykernel::baked::{
-    bake_bvh, bake_bvh4, baked_len, read_header, BakedKind, BakedMode, BakedScalar, MAX_ALIGN,
-};
-use raykernel::bvh::{nodes_needed, BuildOptions, DEFAULT_LEAF_SIZE, MAX_LEAF_SIZE};
-use raykernel::bvh4::nodes4_needed;
-use raykernel::{Baked, Bvh, Bvh4, Node, Node4, Triangle, I16F16};
+use raykernel::baked::{read_header, BakedKind, BakedMode, BakedScalar, MAX_ALIGN};
+use raykernel::bvh::{BuildOptions, DEFAULT_LEAF_SIZE, MAX_LEAF_SIZE};
+use raykernel::{AnyAccel, Baked, Triangle, I16F16};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -153,13 +150,13 @@ fn bake_triangles<S: BakedScalar>(
         scene: args.scene.clone(),
         source,
     };
-    let n = tris.len();
-    let mut nodes = vec![Node::<S>::EMPTY; nodes_needed(n)];
-    let mut ids = vec![0u32; n];
-    let bvh = if args.leaf_order {
-        Bvh::build_in_leaf_order(&mut tris, &mut nodes, &mut ids, options)
+    let accel = args.accel.kind().accel(options);
+    let mut arena = NodeArena::<S>::for_accel(accel, &tris);
+    let mut memory = arena.memory();
+    let built = if args.leaf_order {
+        AnyAccel::build_in_leaf_order(accel, &mut tris, &mut memory)
     } else {
-        Bvh::build(&tris, &mut nodes, &mut ids, options)
+        AnyAccel::build(accel, &tris, &mut memory)
     }
     .map_err(build_error)?;
     let too_large = || Error::Output {
@@ -170,22 +167,11 @@ fn bake_triangles<S: BakedScalar>(
         path: args.out.clone(),
         msg: e.to_string(),
     };
-    match args.accel {
-        BakeAccel::Bvh => {
-            let len = baked_len(BakedKind::Bvh, bvh.nodes().len(), n).ok_or_else(too_large)?;
-            let mut out = vec![0u8; len];
-            bake_bvh(&bvh, &mut out).map_err(bake_error)?;
-            Ok((out, grid_hash(&bvh)))
-        }
-        BakeAccel::Bvh4 => {
-            let mut nodes4 = vec![Node4::<S>::EMPTY; nodes4_needed(n)];
-            let wide = Bvh4::collapse(&bvh, &mut nodes4).map_err(build_error)?;
-            let len = baked_len(BakedKind::Bvh4, wide.nodes().len(), n).ok_or_else(too_large)?;
-            let mut out = vec![0u8; len];
-            bake_bvh4(&wide, &mut out).map_err(bake_error)?;
-            Ok((out, grid_hash(&wide)))
-        }
-    }
+    // A BVH kind always builds a BVH; `too_large` is never reached through `from_any`.
+    let tree = Baked::from_any(built).ok_or_else(too_large)?;
+    let mut out = vec![0u8; tree.baked_len().ok_or_else(too_large)?];
+    tree.bake(&mut out).map_err(bake_error)?;
+    Ok((out, grid_hash(&tree)))
 }
 
 /// `raykernel bake`: build, bake, write.
@@ -205,10 +191,7 @@ pub fn run_bake(args: &BakeArgs) -> Result<BakeReport, Error> {
     Ok(BakeReport {
         scene: args.scene.display().to_string(),
         out: args.out.display().to_string(),
-        accel: match header.kind {
-            BakedKind::Bvh => "bvh",
-            BakedKind::Bvh4 => "bvh4",
-        },
+        accel: header.kind.name(),
         mode: args.mode.name(),
         triangles: header.prim_count as usize,
         nodes: header.node_count as usize,
@@ -317,10 +300,7 @@ pub fn run_trace_baked(args: &TraceBakedArgs) -> Result<TraceBakedReport, Error>
     let header = read_header(bytes).ok();
     Ok(TraceBakedReport {
         baked: args.baked.display().to_string(),
-        accel: match header.map(|h| h.kind) {
-            Some(BakedKind::Bvh4) => "bvh4",
-            _ => "bvh",
-        },
+        accel: header.map_or(BakedKind::Bvh, |h| h.kind).name(),
         mode: match header.map(|h| h.mode) {
             Some(BakedMode::Fixed) => "fixed",
             _ => "f32",

@@ -1,7 +1,7 @@
 //! Snapshot comparisons: rendered images against committed goldens, exactly.
 //!
 //! Two goldens per render: its FNV-1a-64 hash (over the 8-bit sRGB bytes, row-major, as
-//! `tests/golden/cases.rs` hashes the kernel's renders) in the one hash file
+//! `testkit/src/golden.rs` hashes the kernel's renders) in the one hash file
 //! `tests/golden/kernel_hashes.txt`, shared with the kernel's and the on-target tests; and a
 //! small PNG in `tests/golden/images/`, so a failure can show what changed. A mismatch writes
 //! `NAME.actual.png` and `NAME.diff.png` (differing pixels red over a dimmed copy of the

@@ -22,7 +22,7 @@ fn generated_obj(dir: &Path) -> PathBuf {
     let mut rng = Rng::new(0xBA4E);
     let mut text = String::new();
     for v in &verts {
-        let r = 1.2 + 0.05 * rng.range(-1.0, 1.0);
+        let r = 1.2 + 0.05 * rng.range_f64(-1.0, 1.0);
         writeln!(text, "v {} {} {}", v[0] * r, v[1] * r, v[2] * r).unwrap();
     }
     for f in &faces {

@@ -42,7 +42,7 @@ fn scene(name: &str) -> Scene {
     let mut inside = Vec::new();
     // From inside: random points within half the radius, random directions.
     for _ in 0..600 {
-        let o = [0, 1, 2].map(|k| c[k] + rng.range(-0.55, 0.55) as f32);
+        let o = [0, 1, 2].map(|k| c[k] + rng.range_f64(-0.55, 0.55) as f32);
         inside.push(rays.len());
         rays.push(RayRecord::new(o, rng.direction()));
     }
@@ -64,8 +64,8 @@ fn scene(name: &str) -> Scene {
     // Finite intervals that cut the sphere off or start past the near hit.
     for _ in 0..200 {
         let mut r = random_rays(&mut rng, [-4.0; 3], [4.0; 3], 1)[0];
-        r.t_min = rng.range(0.0, 3.0) as f32;
-        r.t_max = r.t_min + rng.range(0.0, 4.0) as f32;
+        r.t_min = rng.range_f64(0.0, 3.0) as f32;
+        r.t_max = r.t_min + rng.range_f64(0.0, 4.0) as f32;
         rays.push(r);
     }
     let bad = vec![rays.len(), rays.len() + 1, rays.len() + 2];

@@ -14,9 +14,9 @@ fn some_rays() -> Vec<RayRecord> {
     let mut rng = Rng::new(7);
     let mut rays: Vec<RayRecord> = (0..100)
         .map(|_| RayRecord {
-            origin: [0, 1, 2].map(|_| rng.range(-100.0, 100.0) as f32),
+            origin: [0, 1, 2].map(|_| rng.range_f64(-100.0, 100.0) as f32),
             dir: rng.direction(),
-            t_min: rng.range(0.0, 1.0) as f32,
+            t_min: rng.range_f64(0.0, 1.0) as f32,
             t_max: f32::INFINITY,
         })
         .collect();

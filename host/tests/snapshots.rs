@@ -8,11 +8,9 @@
 //! `cargo xtask bless` (or `BLESS=1 cargo test -p raykernel-host --test snapshots`) rewrites the
 //! PNGs; the hash lines are the kernel's (`BLESS=1 cargo test -p raykernel --test golden`).
 
-#[path = "../../tests/golden/cases.rs"]
-#[allow(dead_code, clippy::all)]
-mod cases;
-
 mod common;
+
+use raykernel_testkit::golden as cases;
 
 use host::render::{decode_png, encode_png, mode_name, render, Image, RenderOptions};
 use host::snapshot::{compare_with_png, diff_image, fnv1a64, snapshot_name};
@@ -57,7 +55,7 @@ fn every_built_in_scene_matches_its_golden_hash_and_image_in_both_modes() {
     let kernel_has_renders = hashes.iter().any(|(n, _)| n.starts_with("render_"));
     if !kernel_has_renders {
         eprintln!(
-            "note: {} has no render_* lines yet (tests/golden/cases.rs has no render cases); \
+            "note: {} has no render_* lines yet (testkit/src/golden.rs has no render cases); \
              checking the PNGs only",
             hash_file.display()
         );
@@ -76,7 +74,7 @@ fn every_built_in_scene_matches_its_golden_hash_and_image_in_both_modes() {
                     hash_file.display()
                 )),
                 None if kernel_has_renders => failures.push(format!(
-                    "{}: no line `{line}`: add the case to tests/golden/cases.rs and run \
+                    "{}: no line `{line}`: add the case to testkit/src/golden.rs and run \
                      `cargo xtask bless`",
                     hash_file.display()
                 )),

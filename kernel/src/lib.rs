@@ -51,8 +51,9 @@ pub use accel::grid::Grid;
 pub use accel::kdtree::{KdNode, KdTree};
 pub use accel::{
     Accel, AccelFamily, AccelKind, AccelMemory, AccelVisitor, AnyAccel, AnyFamily, Arena,
-    BuildError, Bvh4Family, BvhFamily, Counters, GridFamily, KdTreeFamily, Linear, LinearFamily,
-    MemoryNeeded, Nearest, NoStats, TraversalStats, TrianglesOnly, UnknownAccel, MAX_PRIMS,
+    BuildError, Bvh4Family, BvhFamily, Counters, GridFamily, InvalidAccel, KdTreeFamily, Linear,
+    LinearFamily, MemoryNeeded, Nearest, NoStats, TraversalStats, TrianglesOnly, UnknownAccel,
+    MAX_PRIMS,
 };
 pub use geom::{spawn, Aabb, Hit, Primitive, Ray, Sphere, Triangle};
 pub use glam;

@@ -9,14 +9,14 @@
 
 mod common;
 
-use common::{query, same_hit, Rng, TestScalar};
+use common::{query, same_hit, TestScalar};
 use raykernel::baked::{
-    bake_bvh, bake_bvh4, baked_len, checksum, load_bvh, load_bvh4, read_header, BakedKind,
-    BakedScalar, HEADER_LEN, MAX_ALIGN,
+    checksum, load_bvh, load_bvh4, read_header, BakedKind, BakedScalar, HEADER_LEN, MAX_ALIGN,
 };
 use raykernel::bvh::{nodes_needed, BuildOptions};
-use raykernel::bvh4::nodes4_needed;
-use raykernel::{Accel, BakeError, Baked, Bvh, Bvh4, Linear, Node, Node4, Ray, Triangle, I16F16};
+use raykernel::{Accel, AnyAccel, BakeError, Baked, Bvh, Linear, Node, Ray, Triangle, I16F16};
+use raykernel_testkit::memory::OwnedMemory;
+use raykernel_testkit::Rng;
 
 /// A byte buffer whose `bytes()` start at a multiple of [`MAX_ALIGN`] (plus `shift`).
 struct Aligned {
@@ -110,6 +110,28 @@ fn same_answers<S: TestScalar, A: Accel<S>, B: Accel<S>>(
     Ok(())
 }
 
+/// Builds a tree of `kind` over `tris` (through [`AnyAccel`], into exactly the memory it
+/// needs) and hands it to `f`.
+fn with_tree<S: TestScalar + BakedScalar, R>(
+    tris: &[Triangle<S>],
+    kind: BakedKind,
+    options: BuildOptions,
+    leaf_order: bool,
+    f: impl FnOnce(&Baked<'_, S>) -> R,
+) -> R {
+    let accel = kind.accel(options);
+    let mut own = tris.to_vec();
+    let mut arena = OwnedMemory::<S>::for_kind(accel, tris);
+    let mut memory = arena.memory();
+    let built = if leaf_order {
+        AnyAccel::build_in_leaf_order(accel, &mut own, &mut memory)
+    } else {
+        AnyAccel::build(accel, tris, &mut memory)
+    }
+    .unwrap_or_else(|e| panic!("{} build {accel}: {e}", S::NAME));
+    f(&Baked::from_any(built).expect("a BVH kind builds a BVH"))
+}
+
 /// Builds over `tris` and bakes a tree of `kind`.
 fn bake<S: TestScalar + BakedScalar>(
     tris: &[Triangle<S>],
@@ -117,29 +139,11 @@ fn bake<S: TestScalar + BakedScalar>(
     options: BuildOptions,
     leaf_order: bool,
 ) -> Vec<u8> {
-    let mut own = tris.to_vec();
-    let mut nodes = vec![Node::<S>::EMPTY; nodes_needed(tris.len())];
-    let mut ids = vec![0u32; tris.len()];
-    let bvh = if leaf_order {
-        Bvh::build_in_leaf_order(&mut own, &mut nodes, &mut ids, options)
-    } else {
-        Bvh::build(tris, &mut nodes, &mut ids, options)
-    }
-    .unwrap();
-    match kind {
-        BakedKind::Bvh => {
-            let mut out = vec![0u8; baked_len(kind, bvh.nodes().len(), tris.len()).unwrap()];
-            assert_eq!(bake_bvh(&bvh, &mut out), Ok(out.len()));
-            out
-        }
-        BakedKind::Bvh4 => {
-            let mut nodes4 = vec![Node4::<S>::EMPTY; nodes4_needed(tris.len())];
-            let wide = Bvh4::collapse(&bvh, &mut nodes4).unwrap();
-            let mut out = vec![0u8; baked_len(kind, wide.nodes().len(), tris.len()).unwrap()];
-            assert_eq!(bake_bvh4(&wide, &mut out), Ok(out.len()));
-            out
-        }
-    }
+    with_tree(tris, kind, options, leaf_order, |tree| {
+        let mut out = vec![0u8; tree.baked_len().unwrap()];
+        assert_eq!(tree.bake(&mut out), Ok(out.len()));
+        out
+    })
 }
 
 fn round_trip<S: TestScalar + BakedScalar>() {
@@ -180,7 +184,7 @@ fn round_trip<S: TestScalar + BakedScalar>() {
                 assert_eq!(wide.prim_ids(), built.prim_ids(), "{case}");
                 same_answers(&wide, &linear, &rays).unwrap_or_else(|e| panic!("{case}: {e}"));
                 let any = Baked::<S>::load(file4.bytes()).unwrap();
-                assert!(matches!(any, Baked::Bvh4(_)), "{case}");
+                assert_eq!(any.kind(), BakedKind::Bvh4, "{case}");
                 same_answers(&any, &linear, &rays).unwrap_or_else(|e| panic!("{case}: {e}"));
             }
         }
@@ -206,11 +210,7 @@ fn loads_and_agrees<S: TestScalar + BakedScalar>(
     match Baked::<S>::load(bytes) {
         Err(_) => Ok(false),
         Ok(tree) => {
-            let (ids, prims, leaf_order) = match &tree {
-                Baked::Bvh(t) => (t.prim_ids(), t.prims(), t.is_leaf_order()),
-                Baked::Bvh4(t) => (t.prim_ids(), t.prims(), t.is_leaf_order()),
-            };
-            let reference = by_id(ids, prims, leaf_order);
+            let reference = by_id(tree.prim_ids(), tree.prims(), tree.is_leaf_order());
             same_answers(&tree, &Linear::new(&reference), rays)?;
             Ok(true)
         }
@@ -347,22 +347,9 @@ fn alignment_length_checksum_mode_and_kind_are_checked() {
             Err(BakeError::BadChecksum { .. })
         ));
         let mut small = vec![0u8; bytes.len() - 1];
-        let tiny = match kind {
-            BakedKind::Bvh => {
-                let mut nodes = vec![Node::<f32>::EMPTY; nodes_needed(50)];
-                let mut ids = vec![0u32; 50];
-                let bvh = Bvh::build(&tris, &mut nodes, &mut ids, BuildOptions::default()).unwrap();
-                bake_bvh(&bvh, &mut small)
-            }
-            BakedKind::Bvh4 => {
-                let mut nodes = vec![Node::<f32>::EMPTY; nodes_needed(50)];
-                let mut ids = vec![0u32; 50];
-                let bvh = Bvh::build(&tris, &mut nodes, &mut ids, BuildOptions::default()).unwrap();
-                let mut nodes4 = vec![Node4::<f32>::EMPTY; nodes4_needed(50)];
-                let wide = Bvh4::collapse(&bvh, &mut nodes4).unwrap();
-                bake_bvh4(&wide, &mut small)
-            }
-        };
+        let tiny = with_tree(&tris, kind, BuildOptions::default(), false, |tree| {
+            tree.bake(&mut small)
+        });
         assert_eq!(
             tiny,
             Err(BakeError::Truncated {

@@ -10,11 +10,13 @@
 
 mod common;
 
-use common::{c, query, same_hit, with_bvh, with_bvh4, RaySpec, Rng, TestScalar, LEAF_SIZES};
+use common::{c, query, same_hit, with_bvh, with_bvh4, RaySpec, TestScalar, LEAF_SIZES};
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
 use raykernel::Arena;
 use raykernel::{Accel, BuildError, Bvh, Bvh4, Linear, Node, Node4, Ray, Scalar, Triangle, I16F16};
+use raykernel_testkit::icosphere::unit_icosphere;
+use raykernel_testkit::Rng;
 
 fn tri<S: TestScalar>(v: [[f32; 3]; 3]) -> Triangle<S> {
     Triangle::from_f32(v).unwrap_or_else(|e| panic!("{} {v:?}: {e:?}", S::NAME))
@@ -324,7 +326,7 @@ fn empty_and_one_primitive_scenes_fixed() {
 // A deeper tree: a closed sphere of 5120 triangles, every builder and leaf size, leaf order
 
 fn sphere<S: TestScalar>(radius: f64) -> Vec<Triangle<S>> {
-    let (verts, faces) = common::unit_icosphere(4);
+    let (verts, faces) = unit_icosphere(4);
     faces
         .iter()
         .map(|f| tri::<S>(f.map(|i| verts[i as usize].map(|x| (x * radius) as f32))))

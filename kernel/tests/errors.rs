@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{all_options, c, p, query, same_hit, with_bvh, RaySpec, Rng, TestScalar};
+use common::{all_options, c, p, query, same_hit, with_bvh, RaySpec, TestScalar};
 use raykernel::bvh::{
     nodes_needed, BuildOptions, BuilderKind, MAX_DEPTH, MAX_LEAF_SIZE, MEDIAN_FALLBACK_DEPTH,
 };
@@ -16,6 +16,7 @@ use raykernel::{
     Accel, BuildError, Bvh, Linear, Node, PointError, Ray, RayError, Sphere, Triangle,
     F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16,
 };
+use raykernel_testkit::Rng;
 
 fn tri<S: TestScalar>(v: [[f32; 3]; 3]) -> Triangle<S> {
     Triangle { v: v.map(p::<S>) }

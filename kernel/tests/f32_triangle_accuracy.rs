@@ -9,6 +9,8 @@
 //! Deterministic (seeded); a failure prints the seed index and the triangle.
 
 use raykernel::{Ray, Triangle};
+use raykernel_testkit::vec3::{add_scaled, to_f32};
+use raykernel_testkit::Rng;
 
 /// Exact-enough double-`f64` arithmetic for the reference (about 106 bits).
 #[derive(Clone, Copy, Debug)]
@@ -183,74 +185,48 @@ fn measure(stats: &mut Stats, ray: &Ray<f32>, v: [[f32; 3]; 3], case: &str) {
     stats.add(new, old);
 }
 
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        // SplitMix64.
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
-    }
-    fn vec(&mut self, r: f64) -> [f64; 3] {
-        [self.range(-r, r), self.range(-r, r), self.range(-r, r)]
-    }
-}
-
-fn add(a: [f64; 3], b: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] + b[0] * s, a[1] + b[1] * s, a[2] + b[2] * s]
-}
-
-fn f32s(a: [f64; 3]) -> [f32; 3] {
-    a.map(|x| x as f32)
-}
-
 /// A ray from a random origin through a random point `p` of a random triangle, which is
 /// well-conditioned, a long thin sliver, or nearly edge-on to the ray.
 fn random_case(rng: &mut Rng, kind: usize) -> (Ray<f32>, [[f32; 3]; 3]) {
-    let scale = [1e-3, 1.0, 1e3, 1e6][(rng.next() % 4) as usize];
-    let origin = rng.vec(scale);
-    let p = rng.vec(scale);
+    let scale = [1e-3, 1.0, 1e3, 1e6][(rng.next_u64() % 4) as usize];
+    let origin = rng.cube_f64(scale);
+    let p = rng.cube_f64(scale);
     let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
-    let size = scale * rng.range(0.01, 1.0);
+    let size = scale * rng.range_f64(0.01, 1.0);
     let v = match kind {
         // Well-conditioned: three vertices around p.
-        0 => [0, 1, 2].map(|_| f32s(add(p, rng.vec(size), 1.0))),
+        0 => [0, 1, 2].map(|_| to_f32(add_scaled(p, rng.cube_f64(size), 1.0))),
         // Long and thin: two vertices far apart on a line through p, the third just off it.
         1 => {
-            let axis = rng.vec(1.0);
-            let thin = size * libm::exp2(-rng.range(8.0, 24.0));
-            let off = rng.vec(thin);
-            let a = add(p, axis, size * rng.range(0.2, 1.0));
-            let b = add(p, axis, -size * rng.range(0.2, 1.0));
-            let c = add(add(p, axis, size * rng.range(-0.1, 0.1)), off, 1.0);
-            [f32s(a), f32s(b), f32s(c)]
+            let axis = rng.cube_f64(1.0);
+            let thin = size * libm::exp2(-rng.range_f64(8.0, 24.0));
+            let off = rng.cube_f64(thin);
+            let a = add_scaled(p, axis, size * rng.range_f64(0.2, 1.0));
+            let b = add_scaled(p, axis, -size * rng.range_f64(0.2, 1.0));
+            let c = add_scaled(
+                add_scaled(p, axis, size * rng.range_f64(-0.1, 0.1)),
+                off,
+                1.0,
+            );
+            [to_f32(a), to_f32(b), to_f32(c)]
         }
         // Nearly edge-on: the triangle's plane almost contains the ray direction.
         _ => {
-            let tilt = libm::exp2(-rng.range(6.0, 20.0));
-            let side = rng.vec(1.0);
-            let a = add(add(p, d, tilt), side, size);
-            let b = add(add(p, d, -tilt), side, -size);
-            let c = add(p, rng.vec(size), tilt);
-            [f32s(a), f32s(b), f32s(c)]
+            let tilt = libm::exp2(-rng.range_f64(6.0, 20.0));
+            let side = rng.cube_f64(1.0);
+            let a = add_scaled(add_scaled(p, d, tilt), side, size);
+            let b = add_scaled(add_scaled(p, d, -tilt), side, -size);
+            let c = add_scaled(p, rng.cube_f64(size), tilt);
+            [to_f32(a), to_f32(b), to_f32(c)]
         }
     };
-    let ray = Ray::from_f32(f32s(origin), f32s(d), 0.0, f32::INFINITY).expect("valid ray");
+    let ray = Ray::from_f32(to_f32(origin), to_f32(d), 0.0, f32::INFINITY).expect("valid ray");
     (ray, v)
 }
 
 #[test]
 fn triangle_t_is_as_accurate_as_the_f64_solve_on_random_triangles() {
-    let mut rng = Rng(0x7a11_d157_0001);
+    let mut rng = Rng::new(0x7a11_d157_0001);
     for (kind, what) in ["well-conditioned", "long thin slivers", "nearly edge-on"]
         .iter()
         .enumerate()
@@ -307,13 +283,13 @@ fn triangle_t_is_as_accurate_as_the_f64_solve_on_the_bunny() {
             hi[k] = hi[k].max(p[k]);
         }
     }
-    let mut rng = Rng(0xb0_0001);
+    let mut rng = Rng::new(0xb0_0001);
     let mut stats = Stats::default();
     // Rays from random points of the scene's box through a random interior point of each
     // triangle (every eighth).
     for (i, v) in tris.iter().enumerate().step_by(8) {
-        let o: [f32; 3] = std::array::from_fn(|k| rng.range(lo[k] as f64, hi[k] as f64) as f32);
-        let (a, b) = (rng.unit(), rng.unit());
+        let o: [f32; 3] = std::array::from_fn(|k| rng.range_f64(lo[k] as f64, hi[k] as f64) as f32);
+        let (a, b) = (rng.unit_f64(), rng.unit_f64());
         let (a, b) = if a + b > 1.0 {
             (1.0 - a, 1.0 - b)
         } else {
@@ -324,7 +300,7 @@ fn triangle_t_is_as_accurate_as_the_f64_solve_on_the_bunny() {
                 + a * (v[1][k] as f64 - v[0][k] as f64)
                 + b * (v[2][k] as f64 - v[0][k] as f64)
         });
-        let d = f32s([p[0] - o[0] as f64, p[1] - o[1] as f64, p[2] - o[2] as f64]);
+        let d = to_f32([p[0] - o[0] as f64, p[1] - o[1] as f64, p[2] - o[2] as f64]);
         let Ok(ray) = Ray::from_f32(o, d, 0.0, f32::INFINITY) else {
             continue;
         };

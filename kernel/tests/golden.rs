@@ -1,9 +1,8 @@
 //! Golden hashes shared with the on-target tests (`tests/qemu`): computes every case of
-//! `tests/golden/cases.rs` on the host and compares with `tests/golden/kernel_hashes.txt`, the
+//! `raykernel_testkit::golden` on the host and compares with `tests/golden/kernel_hashes.txt`, the
 //! one file both sides read. `BLESS=1 cargo test -p raykernel --test golden` rewrites it.
 
-#[path = "../../tests/golden/cases.rs"]
-mod cases;
+use raykernel_testkit::golden as cases;
 
 use std::path::PathBuf;
 
@@ -13,7 +12,7 @@ fn golden_path() -> PathBuf {
 
 fn render(values: &[(&str, u64)]) -> String {
     let mut s = String::from(
-        "# FNV-1a hashes of kernel results on the cases of tests/golden/cases.rs, read by the\n\
+        "# FNV-1a hashes of kernel results on the cases of raykernel_testkit::golden, read by the\n\
          # host test kernel/tests/golden.rs and by the on-target tests (tests/qemu/build.rs).\n\
          # Rewrite with: BLESS=1 cargo test -p raykernel --test golden\n",
     );

@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{c, p, query, same_hit, with_grid, with_kdtree, RaySpec, Rng, TestScalar};
+use common::{c, p, query, same_hit, with_grid, with_kdtree, RaySpec, TestScalar};
 use raykernel::grid::{GridSize, MAX_DENSITY};
 use raykernel::kdtree::{nodes_needed, refs_needed, MAX_DEPTH};
 use raykernel::Arena;
@@ -16,6 +16,7 @@ use raykernel::{
     grid::GridOptions, kdtree::KdOptions, Accel, BuildError, Grid, KdNode, KdTree, Linear,
     Primitive, Ray, Sphere, Triangle, I16F16,
 };
+use raykernel_testkit::Rng;
 
 fn tri<S: TestScalar>(v: [[f32; 3]; 3]) -> Triangle<S> {
     Triangle { v: v.map(p::<S>) }

@@ -19,15 +19,16 @@
 mod common;
 
 use common::{
-    all_options, dir_to, query, same_hit, with_bvh, with_bvh4, with_grid, with_kdtree, RaySpec,
-    TestScalar, GRID_DENSITIES, KD_DEPTHS,
+    all_options, dir_to, query, same_hit, with_accel, with_bvh, with_bvh4, RaySpec, TestScalar,
+    GRID_DENSITIES, KD_DEPTHS,
 };
 use proptest::prelude::*;
 use proptest::test_runner::{Config as ProptestConfig, RngSeed};
 use raykernel::bvh::BuildOptions;
 use raykernel::bvh4::nodes4_needed;
 use raykernel::{
-    grid::GridOptions, kdtree::KdOptions, Accel, Linear, Primitive, Sphere, Triangle, I16F16,
+    grid::GridOptions, kdtree::KdOptions, Accel, AccelKind, Linear, Primitive, Sphere, Triangle,
+    I16F16,
 };
 
 const SEED: u64 = 0x5eed_7a11_0001;
@@ -388,16 +389,11 @@ fn check_differential<S: TestScalar, P: Primitive<S> + std::fmt::Debug>(
         }
         Ok::<(), String>(())
     };
-    for density in GRID_DENSITIES {
-        let options = GridOptions { density };
-        with_grid::<S, P, _>(prims, options, |grid| {
-            compare(&format!("{options:?}"), &|r| query(grid, &r.ray::<S>()))
-        })?;
-    }
-    for max_depth in KD_DEPTHS {
-        let options = KdOptions { max_depth };
-        with_kdtree::<S, P, _>(prims, options, |tree| {
-            compare(&format!("{options:?}"), &|r| query(tree, &r.ray::<S>()))
+    let grids = GRID_DENSITIES.map(|density| AccelKind::Grid(GridOptions { density }));
+    let kd_trees = KD_DEPTHS.map(|max_depth| AccelKind::KdTree(KdOptions { max_depth }));
+    for kind in grids.into_iter().chain(kd_trees) {
+        with_accel::<S, P, _>(kind, prims, |accel| {
+            compare(&kind.to_string(), &|r| query(accel, &r.ray::<S>()))
         })?;
     }
     Ok(())

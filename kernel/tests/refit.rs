@@ -5,11 +5,13 @@
 
 mod common;
 
-use common::{query, same_hit, unit_icosphere, Rng, TestScalar};
+use common::{query, same_hit, TestScalar};
 use proptest::prelude::*;
 use raykernel::bvh::{nodes_needed, BuildOptions, RefitError};
 use raykernel::bvh4::nodes4_needed;
 use raykernel::{Bvh, Bvh4, Linear, Node, Node4, Ray, Triangle, I16F16};
+use raykernel_testkit::icosphere::unit_icosphere;
+use raykernel_testkit::Rng;
 
 /// `f32` vertices of a mesh.
 type Verts = Vec<[[f32; 3]; 3]>;

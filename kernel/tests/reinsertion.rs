@@ -4,9 +4,10 @@
 
 mod common;
 
-use common::{query, same_hit, with_bvh, RaySpec, Rng, TestScalar};
+use common::{query, same_hit, with_bvh, RaySpec, TestScalar};
 use raykernel::bvh::{BuildOptions, BuilderKind};
 use raykernel::{Bvh, Linear, Node, Scalar, Triangle, I16F16};
+use raykernel_testkit::Rng;
 
 /// Summed half surface area of the inner nodes: the cost reinsertion lowers.
 fn inner_area<S: Scalar, P: raykernel::Primitive<S>>(bvh: &Bvh<'_, S, P>) -> f64 {

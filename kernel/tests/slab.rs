@@ -8,8 +8,9 @@
 
 mod common;
 
-use common::{c, p, RaySpec, Rng, TestScalar};
+use common::{c, p, RaySpec, TestScalar};
 use raykernel::{Aabb, I16F16};
+use raykernel_testkit::Rng;
 
 /// The exact entry distance of the ray into the closed box over `[t_min, t_max]`, if any.
 fn exact_entry(lo: [f32; 3], hi: [f32; 3], r: &RaySpec) -> Option<f64> {

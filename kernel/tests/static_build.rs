@@ -3,11 +3,12 @@
 
 mod common;
 
-use common::{Rng, TestScalar};
+use common::TestScalar;
 use raykernel::bvh::{
     nodes_needed, BuildOptions, BuildSettings, BuilderKind, Median, Midpoint, Sah, StaticBuild,
 };
 use raykernel::{Bvh, Node, Triangle, I16F16};
+use raykernel_testkit::Rng;
 
 /// Random triangles in a box, some large and overlapping, some tiny: every rule splits them
 /// differently, and reinsertion has work to do.

@@ -11,14 +11,18 @@
 
 mod common;
 
-use common::{Rng, TestScalar};
+use common::{hit_bits, TestScalar};
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::spawn::{offset_origin, spawn_ray, spawn_shadow_ray, SpawnScalar};
 use raykernel::{
-    grid::GridOptions, kdtree, kdtree::KdOptions, Aabb, Accel, Arena, BuildError, Bvh, Grid, Hit,
-    KdNode, KdTree, Linear, Node, PointError, Primitive, Ray, RayError, Scalar, Triangle, Vec3x,
-    I16F16,
+    grid::GridOptions, kdtree::KdOptions, Aabb, Accel, AccelKind, AccelVisitor, AnyAccel, Arena,
+    BuildError, Bvh, Hit, Linear, Node, PointError, Primitive, Ray, RayError, Scalar, Triangle,
+    Vec3x, I16F16,
 };
+use raykernel_testkit::icosphere::unit_icosphere;
+use raykernel_testkit::memory::OwnedMemory;
+use raykernel_testkit::vec3::{cross, dot, normalize, sub};
+use raykernel_testkit::Rng;
 use std::collections::{BTreeMap, HashMap};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
@@ -185,27 +189,9 @@ fn to_f64<S: Mode>(p: [S; 3]) -> [f64; 3] {
     p.map(SpawnScalar::to_f64)
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn unit(v: [f64; 3]) -> [f64; 3] {
-    let l = dot(v, v).sqrt();
-    v.map(|x| x / l)
-}
-
 fn tri_normal<S: Mode>(t: &Triangle<S>) -> [f64; 3] {
     let v = t.v.map(to_f64::<S>);
-    unit(cross(sub(v[1], v[0]), sub(v[2], v[0])))
+    normalize(cross(sub(v[1], v[0]), sub(v[2], v[0])))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -305,7 +291,7 @@ impl Mesh {
 }
 
 fn icosphere(level: u32) -> Mesh {
-    let (verts, faces) = common::unit_icosphere(level);
+    let (verts, faces) = unit_icosphere(level);
     Mesh {
         name: format!("icosphere{level}"),
         shape: Shape::Sphere,
@@ -492,113 +478,99 @@ fn interior(mesh: &Mesh, target: [f64; 3], rng: &mut Rng) -> [f64; 3] {
 // ---------------------------------------------------------------------------------------------
 // Accelerators and per-ray checks.
 
-/// The accelerators every ray goes through: SAH/4 (the answer), median/1, midpoint/8, the
-/// uniform grid and the kd-tree (default options), and brute force on every
-/// `linear_stride`-th ray.
-struct Accels<'a, S: Mode> {
-    sah: Bvh<'a, S, Triangle<S>>,
-    median: Bvh<'a, S, Triangle<S>>,
-    midpoint: Bvh<'a, S, Triangle<S>>,
-    grid: Grid<'a, S, Triangle<S>>,
-    kdtree: KdTree<'a, S, Triangle<S>>,
-    linear: Linear<'a, S, Triangle<S>>,
-    linear_stride: usize,
-}
-
-struct Arenas<S: Scalar> {
-    nodes: [Vec<Node<S>>; 3],
-    ids: [Vec<u32>; 3],
-    cells: Vec<u32>,
-    grid_refs: Vec<u32>,
-    kd_nodes: Vec<KdNode<S>>,
-    kd_refs: Vec<u32>,
-}
-
-impl<S: Mode> Arenas<S> {
-    fn new(n: usize) -> Self {
-        Self {
-            nodes: [0; 3].map(|_| vec![Node::<S>::EMPTY; nodes_needed(n)]),
-            ids: [0; 3].map(|_| vec![0u32; n]),
-            cells: Vec::new(),
-            grid_refs: Vec::new(),
-            kd_nodes: vec![KdNode::<S>::EMPTY; kdtree::nodes_needed(n)],
-            kd_refs: vec![0u32; kdtree::refs_needed(n)],
-        }
-    }
-}
-
-fn accels<'a, S: Mode>(tris: &'a [Triangle<S>], arenas: &'a mut Arenas<S>) -> Accels<'a, S> {
-    let [n0, n1, n2] = &mut arenas.nodes;
-    let [i0, i1, i2] = &mut arenas.ids;
-    let size =
-        Grid::size_for(tris, GridOptions::default()).unwrap_or_else(|e| panic!("grid size: {e}"));
-    arenas.cells.resize(size.cells, 0);
-    arenas.grid_refs.resize(size.refs, 0);
-    let grid = Grid::build(
-        tris,
-        &mut arenas.cells,
-        &mut arenas.grid_refs,
-        GridOptions::default(),
-    )
-    .unwrap_or_else(|e| panic!("grid build: {e}"));
-    grid.validate().unwrap_or_else(|e| panic!("grid: {e}"));
-    let kdtree = KdTree::build(
-        tris,
-        &mut arenas.kd_nodes,
-        &mut arenas.kd_refs,
-        KdOptions::default(),
-    )
-    .unwrap_or_else(|e| panic!("kd-tree build: {e}"));
-    kdtree.validate().unwrap_or_else(|e| panic!("kd-tree: {e}"));
-    let opts = |builder, max_leaf_size| BuildOptions {
+/// The structures every ray goes through, each checked against the first (SAH/4, the answer):
+/// median/1, midpoint/8, the 4-wide BVH, the uniform grid and the kd-tree (default options),
+/// and brute force on every `linear_stride`-th ray.
+fn kinds() -> [AccelKind; 6] {
+    let bvh = |builder, max_leaf_size| BuildOptions {
         builder,
         max_leaf_size,
         reinsertion: true,
     };
-    let build = |nodes, ids, o: BuildOptions| {
-        let b = Bvh::build(tris, nodes, ids, o).unwrap_or_else(|e| panic!("build {o:?}: {e}"));
-        b.validate().unwrap_or_else(|e| panic!("{o:?}: {e}"));
-        b
-    };
+    [
+        AccelKind::Bvh(bvh(BuilderKind::Sah, 4)),
+        AccelKind::Bvh(bvh(BuilderKind::Median, 1)),
+        AccelKind::Bvh(bvh(BuilderKind::Midpoint, 8)),
+        AccelKind::Bvh4(bvh(BuilderKind::Sah, 4)),
+        AccelKind::Grid(GridOptions::DEFAULT),
+        AccelKind::KdTree(KdOptions::DEFAULT),
+    ]
+}
+
+struct Accels<'a, S: Mode> {
+    /// Built [`kinds`], in order; the first gives the answer.
+    built: Vec<(AccelKind, AnyAccel<'a, S, Triangle<S>>)>,
+    linear: Linear<'a, S, Triangle<S>>,
+    linear_stride: usize,
+}
+
+/// One buffer set per structure, reused (resized) from one mesh placement to the next.
+struct Arenas<S: Scalar>(Vec<OwnedMemory<S>>);
+
+impl<S: Mode> Arenas<S> {
+    fn new() -> Self {
+        Self(kinds().map(|_| OwnedMemory::default()).into())
+    }
+}
+
+/// Builds every structure of [`kinds`] over `tris` into exactly the memory it needs and checks
+/// its invariants.
+fn accels<'a, S: Mode>(tris: &'a [Triangle<S>], arenas: &'a mut Arenas<S>) -> Accels<'a, S> {
+    let built = kinds()
+        .into_iter()
+        .zip(arenas.0.iter_mut())
+        .map(|(kind, arena)| {
+            arena.resize(OwnedMemory::<S>::needed(kind, tris));
+            let accel = AnyAccel::build(kind, tris, &mut arena.memory())
+                .unwrap_or_else(|e| panic!("build {kind}: {e}"));
+            accel.validate().unwrap_or_else(|e| panic!("{kind}: {e}"));
+            (kind, accel)
+        })
+        .collect();
     Accels {
-        sah: build(n0, i0, opts(BuilderKind::Sah, 4)),
-        median: build(n1, i1, opts(BuilderKind::Median, 1)),
-        midpoint: build(n2, i2, opts(BuilderKind::Midpoint, 8)),
-        grid,
-        kdtree,
+        built,
         linear: Linear::new(tris),
         linear_stride: if tris.len() <= 2048 { 1 } else { 97 },
     }
 }
 
-fn bits<S: TestScalar>(h: &Option<Hit<S>>) -> Option<(u32, u32, u32, u32)> {
-    common::hit_bits(h)
+impl<'a, S: Mode> Accels<'a, S> {
+    /// The structure that gives the answer (SAH/4).
+    fn answer(&self) -> &AnyAccel<'a, S, Triangle<S>> {
+        &self.built[0].1
+    }
 }
 
-/// Closest hit of the SAH tree; `mismatch` is set if any other accelerator (or `occluded`)
-/// disagrees.
+/// The closest hit and the any-hit answer of one ray, through whichever structure it visits.
+struct Query<'r, S: Scalar>(&'r Ray<S>);
+
+impl<S: Scalar> AccelVisitor<S> for Query<'_, S> {
+    type Output = (Option<Hit<S>>, bool);
+    fn visit<A: Accel<S>>(self, accel: &A) -> Self::Output {
+        (accel.intersect(self.0), accel.occluded(self.0))
+    }
+}
+
+/// Closest hit of the first structure (SAH/4); `mismatch` is set if any other structure (or
+/// `occluded`) disagrees.
 fn trace<S: Mode>(a: &Accels<S>, ray: &Ray<S>, index: usize) -> (Option<Hit<S>>, Option<String>) {
-    let h = a.sah.intersect(ray);
+    let (first, answer) = &a.built[0];
+    let (h, occluded) = answer.visit(Query(ray));
     let mut bad = None;
-    let want = bits(&h);
-    let mut check = |name: &str, got: Option<Hit<S>>, occ: bool| {
-        if bits(&got) != want || occ != got.is_some() {
+    let want = hit_bits(&h);
+    let mut check = |name: &dyn std::fmt::Display, (got, occ): (Option<Hit<S>>, bool)| {
+        if hit_bits(&got) != want || occ != got.is_some() {
             bad.get_or_insert_with(|| {
-                format!("{name}: {got:?} (occluded {occ}) vs sah {h:?}, ray {ray:?}")
+                format!("{name}: {got:?} (occluded {occ}) vs {first} {h:?}, ray {ray:?}")
             });
         }
     };
-    check("sah", h, a.sah.occluded(ray));
-    check("median", a.median.intersect(ray), a.median.occluded(ray));
-    check(
-        "midpoint",
-        a.midpoint.intersect(ray),
-        a.midpoint.occluded(ray),
-    );
-    check("grid", a.grid.intersect(ray), a.grid.occluded(ray));
-    check("kd-tree", a.kdtree.intersect(ray), a.kdtree.occluded(ray));
+    check(first, (h, occluded));
+    for (kind, accel) in &a.built[1..] {
+        check(kind, accel.visit(Query(ray)));
+    }
     if index % a.linear_stride == 0 {
-        check("linear", a.linear.intersect(ray), a.linear.occluded(ray));
+        check(&"linear", Query(ray).visit(&a.linear));
     }
     (h, bad)
 }
@@ -683,7 +655,7 @@ fn watertight<S: Mode>(meshes: &[Mesh]) {
         };
         for (pi, &(scale, shift)) in places.iter().enumerate() {
             let placed = place::<S>(mesh, scale, shift);
-            let mut arenas = Arenas::new(placed.tris.len());
+            let mut arenas = Arenas::new();
             let acc = accels(&placed.tris, &mut arenas);
             let mt_tris: Vec<MtTri> = if S::COLUMN == F32 {
                 placed
@@ -850,7 +822,7 @@ fn axis_parallel<S: Mode>() {
                 })
             })
             .collect();
-        let mut arenas = Arenas::new(tris.len());
+        let mut arenas = Arenas::new();
         let acc = accels(&tris, &mut arenas);
         let mt_lin = Linear::new(&mt_tris);
         let g = |i: u32| h * (-1.0 + 2.0 * f64::from(i) / f64::from(n));
@@ -1044,7 +1016,7 @@ fn spawned<S: Mode>(meshes: &[Mesh]) {
     let per_job = (spawn_total() / 4).div_ceil(jobs.len() as u64);
     for (mesh, (scale, shift)) in jobs {
         let placed = place::<S>(mesh, scale, shift);
-        let mut arenas = Arenas::new(placed.tris.len());
+        let mut arenas = Arenas::new();
         let acc = accels(&placed.tris, &mut arenas);
         let mt_tris: Vec<MtTri> = placed
             .tris
@@ -1082,7 +1054,7 @@ fn spawned<S: Mode>(meshes: &[Mesh]) {
             let Ok(ray) = S::ray_to(o, placed.world(mp)) else {
                 continue;
             };
-            let Some(hit) = acc.sah.intersect(&ray) else {
+            let Some(hit) = acc.answer().intersect(&ray) else {
                 continue; // a leak: counted by the watertight classes
             };
             done += 1;
@@ -1116,7 +1088,7 @@ fn spawned<S: Mode>(meshes: &[Mesh]) {
                     continue;
                 };
                 refl.rays += 1;
-                let h2 = acc.sah.intersect(&sr);
+                let h2 = acc.answer().intersect(&sr);
                 if h2.is_some_and(|h| h.prim == own) || (outward && h2.is_some()) {
                     refl.false_hits += 1;
                     fails.push(format!(
@@ -1155,14 +1127,14 @@ fn spawned<S: Mode>(meshes: &[Mesh]) {
                     .map(|k| gv[0][k] + af * (gv[1][k] - gv[0][k]) + bf * (gv[2][k] - gv[0][k]));
                 // Offset the target toward the shading point's *offset* origin: the raw hit
                 // point may lie on an edge shared with the target's triangle, i.e. on its plane.
-                let to_target = S::array_to_vec(unit(sub(gq, hp)).map(S::from_f64_dir));
+                let to_target = S::array_to_vec(normalize(sub(gq, hp)).map(S::from_f64_dir));
                 let o_ref = to_f64(offset_origin(&tri, hit.u, hit.v, to_target));
-                let toward = S::array_to_vec(unit(sub(o_ref, gq)).map(S::from_f64_dir));
+                let toward = S::array_to_vec(normalize(sub(o_ref, gq)).map(S::from_f64_dir));
                 let target = offset_origin(&gt, ga, gb, toward);
                 if let Ok(sr) = spawn_shadow_ray(&ray, &hit, &tri, target) {
                     shadow.rays += 1;
-                    let h2 = acc.sah.intersect(&sr);
-                    let occluded = acc.sah.occluded(&sr);
+                    let h2 = acc.answer().intersect(&sr);
+                    let occluded = acc.answer().occluded(&sr);
                     if occluded != h2.is_some() {
                         shadow.mismatches += 1;
                     }
@@ -1202,7 +1174,7 @@ fn spawned<S: Mode>(meshes: &[Mesh]) {
             let ho = hp.map(S::from_f64);
             if let Ok(nr) = S::ray_along(ho, r) {
                 naive.rays += 1;
-                if acc.sah.intersect(&nr).is_some_and(|h| h.prim == own) {
+                if acc.answer().intersect(&nr).is_some_and(|h| h.prim == own) {
                     naive.false_hits += 1;
                 }
                 if S::COLUMN == F32 {
@@ -1331,7 +1303,7 @@ fn degenerate<S: Mode>() {
             let n = cross(sub(v[1], v[0]), sub(v[2], v[0]));
             n == [0.0; 3]
         };
-        let mut arenas = Arenas::new(tris.len());
+        let mut arenas = Arenas::new();
         let acc = accels(&tris, &mut arenas);
         let mut idx = 0;
         for k in 0..64 {

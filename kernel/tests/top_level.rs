@@ -4,7 +4,6 @@
 
 mod common;
 
-use common::Rng;
 use raykernel::bvh::BuildOptions;
 use raykernel::render::{
     memory_needed, Camera, Light, Material, Object, ObjectSlot, RenderMemory, Renderer, Scene,
@@ -15,6 +14,7 @@ use raykernel::{
     AccelFamily, AccelKind, AccelMemory, AnyFamily, BvhFamily, KdNode, LinearFamily, Node, Node4,
     Sphere, I16F16,
 };
+use raykernel_testkit::Rng;
 
 /// `n` small spheres scattered in a box in front of the camera (some overlapping).
 fn spheres<S: SpawnScalar>(n: usize, seed: u64) -> Vec<Sphere<S>> {

@@ -7,30 +7,17 @@
 
 mod common;
 
-use common::{c, dir_to, p, RaySpec, Rng, TestScalar};
+use common::{c, dir_to, p, RaySpec, TestScalar};
 use raykernel::{Primitive, Sphere, Triangle, I16F16};
+use raykernel_testkit::vec3::{cross, dot, normalize, sub};
+use raykernel_testkit::Rng;
 
 fn tri<S: TestScalar>(v: [[f32; 3]; 3]) -> Triangle<S> {
     Triangle::from_f32(v).unwrap_or_else(|e| panic!("{} triangle {v:?}: {e:?}", S::NAME))
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
 fn unit(d: [f32; 3]) -> [f64; 3] {
-    let d = d.map(f64::from);
-    let n = dot(d, d).sqrt();
-    d.map(|x| x / n)
+    normalize(d.map(f64::from))
 }
 
 /// Two-sided Möller–Trumbore in `f64` over the triangle as the mode stores it: (t, u, v) of

@@ -13,9 +13,13 @@
 
 mod common;
 
-use common::{all_options, p, with_bvh, with_grid, with_kdtree, RaySpec, Rng, TestScalar};
+use common::{all_options, p, with_accel, RaySpec, TestScalar};
 use raykernel::bvh::{BuildOptions, BuilderKind};
-use raykernel::{Accel, Linear, Ray, Triangle, I16F16};
+use raykernel::grid::GridOptions;
+use raykernel::kdtree::KdOptions;
+use raykernel::{Accel, AccelKind, Linear, Ray, Triangle, I16F16};
+use raykernel_testkit::icosphere::unit_icosphere;
+use raykernel_testkit::Rng;
 use std::collections::HashMap;
 
 const SEED: u64 = 0x0a7e_7715_0001;
@@ -73,7 +77,7 @@ impl Mesh {
 /// index), scaled to `radius`; each vertex's radius is multiplied by `1 + jitter·r`,
 /// `r` uniform in [-1, 1).
 fn icosphere(level: u32, radius: f64, jitter: f32, rng: &mut Rng) -> Mesh {
-    let (verts, faces) = common::unit_icosphere(level);
+    let (verts, faces) = unit_icosphere(level);
     let verts = verts
         .iter()
         .map(|v| {
@@ -202,6 +206,11 @@ fn leak_report<S: TestScalar>(
     builders: &[BuildOptions],
     linear_stride: usize,
 ) -> (usize, Vec<String>) {
+    // Each BVH, then the uniform grid and the kd-tree with default options.
+    let kinds = builders.iter().map(|&o| AccelKind::Bvh(o)).chain([
+        AccelKind::Grid(GridOptions::DEFAULT),
+        AccelKind::KdTree(KdOptions::DEFAULT),
+    ]);
     let mut total = 0;
     let mut lines = Vec::new();
     let mut note = |accel: String, count: usize, (leaks, shown): (usize, Vec<String>)| {
@@ -221,23 +230,11 @@ fn leak_report<S: TestScalar>(
         let accel = format!("linear (every {linear_stride}th ray)");
         note(accel, sample.len(), (leaks, shown));
     }
-    for &options in builders {
-        let leaks = with_bvh::<S, _, _>(tris, options, |bvh| {
-            bvh.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
-            count_leaks(bvh, rays)
-        });
-        let accel = format!("bvh {}/{}", options.builder.name(), options.max_leaf_size);
-        note(accel, rays.len(), leaks);
+    for kind in kinds {
+        // Built and validated by the helper.
+        let leaks = with_accel::<S, _, _>(kind, tris, |accel| count_leaks(accel, rays));
+        note(kind.to_string(), rays.len(), leaks);
     }
-    // The uniform grid and the kd-tree, default options (built and validated by the helpers).
-    let leaks = with_grid::<S, _, _>(tris, raykernel::grid::GridOptions::default(), |g| {
-        count_leaks(g, rays)
-    });
-    note("grid".into(), rays.len(), leaks);
-    let leaks = with_kdtree::<S, _, _>(tris, raykernel::kdtree::KdOptions::default(), |k| {
-        count_leaks(k, rays)
-    });
-    note("kd-tree".into(), rays.len(), leaks);
     (total, lines)
 }
 

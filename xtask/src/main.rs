@@ -23,9 +23,7 @@
 //! Cargo reads `.cargo/config.toml` from the current directory, so every on-target command runs
 //! inside `tests/qemu`.
 
-#[path = "../../tests/golden/cases.rs"]
-#[allow(dead_code, clippy::all)]
-mod cases;
+use raykernel_testkit::golden as cases;
 mod determinism;
 mod platforms;
 mod size;

@@ -45,7 +45,7 @@ pub fn speed() -> bool {
     }
     let mut ok = true;
     let mut table = String::from(
-        "Rays: the closest hit of the 96 rays of `tests/golden/cases.rs` through a SAH BVH \
+        "Rays: the closest hit of the 96 rays of `testkit/src/golden.rs` through a SAH BVH \
          (default options) over its 80-triangle icosphere, build excluded. Pixels: the \
          built-in Cornell scene at its own settings (64×64, 8 samples per pixel, a BVH per \
          object), scene setup included. Release build as the on-target suite's (opt-level \

@@ -2,41 +2,10 @@
 #![allow(dead_code)]
 
 use host::RayRecord;
+use raykernel_testkit::vec3::{cross, normalize, sub};
 use std::path::{Path, PathBuf};
 
-/// SplitMix64: small, seeded, good enough for test data.
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    /// Uniform in [lo, hi).
-    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
-    }
-    pub fn below(&mut self, n: usize) -> usize {
-        (self.next_u64() % n as u64) as usize
-    }
-    /// Uniform on the unit sphere.
-    pub fn direction(&mut self) -> [f32; 3] {
-        let z = 1.0 - 2.0 * self.unit();
-        let phi = 2.0 * std::f64::consts::PI * self.unit();
-        let s = (1.0 - z * z).max(0.0).sqrt();
-        [(s * phi.cos()) as f32, (s * phi.sin()) as f32, z as f32]
-    }
-}
+pub use raykernel_testkit::Rng;
 
 /// A fresh, empty directory under the integration tests' temp dir.
 pub fn temp_dir(name: &str) -> PathBuf {
@@ -89,21 +58,6 @@ pub struct Camera {
     pub target: [f64; 3],
     pub up: [f64; 3],
     pub vfov_deg: f64,
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn normalize(a: [f64; 3]) -> [f64; 3] {
-    let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
-    a.map(|x| x / l)
 }
 
 impl Camera {
@@ -165,7 +119,7 @@ pub fn bbox(points: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
 pub fn random_rays(rng: &mut Rng, lo: [f32; 3], hi: [f32; 3], n: usize) -> Vec<RayRecord> {
     (0..n)
         .map(|_| {
-            let o = [0, 1, 2].map(|k| rng.range(f64::from(lo[k]), f64::from(hi[k])) as f32);
+            let o = [0, 1, 2].map(|k| rng.range_f64(f64::from(lo[k]), f64::from(hi[k])) as f32);
             RayRecord::new(o, rng.direction())
         })
         .collect()

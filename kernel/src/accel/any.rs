@@ -1,11 +1,11 @@
 //! Any built accelerator, chosen at run time by an [`AccelKind`]: the one place that
 //! dispatches over the structures.
 
-use super::bvh::Bvh;
+use super::bvh::{Bvh, InvalidTree};
 use super::bvh4::Bvh4;
 use super::family::{AccelFamily, Bvh4Family, BvhFamily, GridFamily, KdTreeFamily, LinearFamily};
-use super::grid::Grid;
-use super::kdtree::KdTree;
+use super::grid::{Grid, InvalidGrid};
+use super::kdtree::{InvalidKdTree, KdTree};
 use super::memory::take;
 use super::{Accel, AccelKind, AccelMemory, BuildError, Counters, Linear, MemoryNeeded, Nearest};
 use crate::geom::{Primitive, Ray};
@@ -130,6 +130,47 @@ impl<'a, S: Scalar, P: Primitive<S>> AnyAccel<'a, S, P> {
         }
     }
 }
+
+impl<S: Scalar, P: Primitive<S>> AnyAccel<'_, S, P> {
+    /// Checks every invariant of the structure inside (its own `validate`; brute force has
+    /// none to break).
+    ///
+    /// # Errors
+    /// The first violated invariant, as the structure reports it.
+    pub fn validate(&self) -> Result<(), InvalidAccel> {
+        match self {
+            Self::Linear(_) => Ok(()),
+            Self::Bvh(a) => a.validate().map(drop).map_err(InvalidAccel::Tree),
+            Self::Bvh4(a) => a.validate().map(drop).map_err(InvalidAccel::Tree),
+            Self::Grid(a) => a.validate().map(drop).map_err(InvalidAccel::Grid),
+            Self::KdTree(a) => a.validate().map(drop).map_err(InvalidAccel::KdTree),
+        }
+    }
+}
+
+/// The first violated invariant found by [`AnyAccel::validate`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum InvalidAccel {
+    /// From [`Bvh::validate`] or [`Bvh4::validate`].
+    Tree(InvalidTree),
+    /// From [`Grid::validate`].
+    Grid(InvalidGrid),
+    /// From [`KdTree::validate`].
+    KdTree(InvalidKdTree),
+}
+
+impl core::fmt::Display for InvalidAccel {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Tree(e) => core::fmt::Display::fmt(e, f),
+            Self::Grid(e) => core::fmt::Display::fmt(e, f),
+            Self::KdTree(e) => core::fmt::Display::fmt(e, f),
+        }
+    }
+}
+
+impl core::error::Error for InvalidAccel {}
 
 /// Something to do with a built accelerator, generic over its type, so that
 /// [`AnyAccel::visit`] runs it on the structure itself (monomorphised per structure, no

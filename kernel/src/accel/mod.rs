@@ -17,7 +17,7 @@ mod kind;
 mod linear;
 mod memory;
 
-pub use any::{AccelVisitor, AnyAccel};
+pub use any::{AccelVisitor, AnyAccel, InvalidAccel};
 pub use error::{Arena, BuildError};
 pub use family::{
     AccelFamily, AnyFamily, Bvh4Family, BvhFamily, GridFamily, KdTreeFamily, LinearFamily,

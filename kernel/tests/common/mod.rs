@@ -4,22 +4,24 @@
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
 use raykernel::{
-    grid::GridOptions, kdtree, kdtree::KdOptions, Accel, Bvh, Bvh4, Grid, Hit, KdNode, KdTree,
-    Node, Node4, PointError, Primitive, Ray, Scalar, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16,
+    grid::GridOptions, kdtree, kdtree::KdOptions, Accel, AccelKind, AnyAccel, Bvh, Bvh4, Grid, Hit,
+    KdNode, KdTree, Node, Node4, PointError, Primitive, Ray, Scalar, F32_COORD_LIMIT,
+    FIXED_COORD_LIMIT, I16F16,
 };
+pub use raykernel_testkit::golden::Bits;
+use raykernel_testkit::memory::OwnedMemory;
 use std::fmt;
 use std::ops::{Add, Mul, Sub};
 
 /// Leaf sizes every differential test builds with.
 pub const LEAF_SIZES: [u32; 4] = [1, 2, 4, 8];
 
-/// What the suites need from a number mode beyond [`Scalar`]: exact bits, arithmetic for
-/// computing targets in the mode itself, tolerances and per-mode bad inputs.
+/// What the suites need from a number mode beyond [`Scalar`]: exact bits ([`Bits`], so `-0`
+/// and `+0` differ), arithmetic for computing targets in the mode itself, tolerances and
+/// per-mode bad inputs.
 pub trait TestScalar:
-    Scalar + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self>
+    Scalar + Bits + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self>
 {
-    /// The exact bits (`f32::to_bits`, so `-0` and `+0` differ; raw `i32` for fixed point).
-    fn bits(self) -> u32;
     /// Absolute tolerance for comparing a result of this mode with an `f64` reference of
     /// magnitude `exact` (the reference is computed from the same, already rounded, inputs).
     fn tol(exact: f64) -> f64;
@@ -30,9 +32,6 @@ pub trait TestScalar:
 }
 
 impl TestScalar for f32 {
-    fn bits(self) -> u32 {
-        self.to_bits()
-    }
     fn tol(exact: f64) -> f64 {
         1e-5 * exact.abs().max(1.0)
     }
@@ -56,9 +55,6 @@ impl TestScalar for f32 {
 }
 
 impl TestScalar for I16F16 {
-    fn bits(self) -> u32 {
-        self.raw() as u32
-    }
     fn tol(exact: f64) -> f64 {
         // Q16.16 coordinates and distances (resolution 2^-16), Q2.30 directions; the slab test
         // pads by 2 raw units plus one raw unit of origin shift divided by a direction component.
@@ -284,6 +280,34 @@ where
     f(&tree)
 }
 
+/// Builds `kind` over `prims` through [`AnyAccel::build`] into exactly
+/// [`AccelKind::memory_needed`], checks `validate()` (and a kd-tree's depth limit), and hands
+/// it to `f`.
+pub fn with_accel<S, P, R>(
+    kind: AccelKind,
+    prims: &[P],
+    f: impl FnOnce(&AnyAccel<'_, S, P>) -> R,
+) -> R
+where
+    S: Scalar,
+    P: Primitive<S>,
+{
+    let mut arena = OwnedMemory::<S>::for_kind(kind, prims);
+    let accel = AnyAccel::build(kind, prims, &mut arena.memory())
+        .unwrap_or_else(|e| panic!("{} build {kind} ({} prims): {e}", S::NAME, prims.len()));
+    accel
+        .validate()
+        .unwrap_or_else(|e| panic!("{} {kind}: {e}", S::NAME));
+    if let AccelKind::KdTree(o) = kind {
+        assert!(
+            o.max_depth == 0 || accel.depth() <= o.max_depth,
+            "{} {kind} too deep",
+            S::NAME
+        );
+    }
+    f(&accel)
+}
+
 /// Every (builder, leaf size) combination the differential tests cover, each with
 /// reinsertion, plus SAH without it.
 pub fn all_options() -> impl Iterator<Item = BuildOptions> {
@@ -316,119 +340,4 @@ pub fn query<S: TestScalar, A: Accel<S>>(
         return Err(format!("nearest() = {nearest:?} but intersect() = {hit:?}"));
     }
     Ok(hit)
-}
-
-/// SplitMix64: a tiny seeded generator, identical on every platform.
-#[derive(Clone, Debug)]
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    /// Uniform in `[0, 1)` with 24 random bits.
-    pub fn unit(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
-    }
-    /// Uniform in `[lo, hi)`.
-    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.unit()
-    }
-    /// Uniform in `0..n`.
-    pub fn below(&mut self, n: usize) -> usize {
-        (self.next_u64() % n as u64) as usize
-    }
-    /// A uniformly distributed unit vector (rejection sampling in `f64`).
-    pub fn unit_vec(&mut self) -> [f32; 3] {
-        loop {
-            let v = [0; 3].map(|_| self.range(-1.0, 1.0) as f64);
-            let l2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-            if l2 > 1e-4 && l2 <= 1.0 {
-                let l = l2.sqrt();
-                return v.map(|x| (x / l) as f32);
-            }
-        }
-    }
-    /// A point uniformly distributed in the ball of radius `r` around the origin.
-    pub fn in_ball(&mut self, r: f32) -> [f32; 3] {
-        loop {
-            let v = [0; 3].map(|_| self.range(-r, r));
-            if v[0] * v[0] + v[1] * v[1] + v[2] * v[2] <= r * r {
-                return v;
-            }
-        }
-    }
-}
-
-/// A unit icosahedron subdivided `level` times: each edge's midpoint is pushed onto the sphere
-/// and shared by index, so the mesh is closed and neighbours share edges exactly.
-/// Returns unit-sphere vertices and `20·4^level` triangles.
-pub fn unit_icosphere(level: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    fn normalize(v: [f64; 3]) -> [f64; 3] {
-        let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        v.map(|x| x / n)
-    }
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut verts: Vec<[f64; 3]> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .map(normalize)
-    .to_vec();
-    let mut faces: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..level {
-        let mut mid: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
-        let mut next = Vec::with_capacity(faces.len() * 4);
-        for &[a, b, c] in &faces {
-            let mut m = |x: u32, y: u32| {
-                *mid.entry((x.min(y), x.max(y))).or_insert_with(|| {
-                    let (p, q) = (verts[x as usize], verts[y as usize]);
-                    verts.push(normalize([0, 1, 2].map(|i| p[i] + q[i])));
-                    verts.len() as u32 - 1
-                })
-            };
-            let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        faces = next;
-    }
-    (verts, faces)
 }

@@ -3,8 +3,7 @@
 //! instruction counter of each core, exit codes and the panic handler.
 #![no_std]
 
-#[path = "../../golden/cases.rs"]
-pub mod cases;
+pub use raykernel_testkit::golden as cases;
 pub mod counter;
 pub mod known_answers;
 pub mod speed;

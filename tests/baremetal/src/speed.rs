@@ -2,7 +2,7 @@
 //! shift=0`, see `counter.rs`). The workloads are the golden ones, and each is checked against
 //! its golden answer, so nothing is counted while giving wrong answers:
 //!
-//! - rays: the 80-triangle icosphere of `tests/golden/cases.rs`, SAH BVH (default options),
+//! - rays: the 80-triangle icosphere of `testkit/src/golden.rs`, SAH BVH (default options),
 //!   the closest hit of its 96 rays (built and prepared outside the count), in each mode;
 //! - pixels: the built-in Cornell scene at its own settings (64×64, 8 samples per pixel),
 //!   rendered row by row to sRGB bytes in each mode, scene setup and per-object BVH builds

@@ -5,14 +5,12 @@
 //! grazing it from the side, some with a bounded interval. Everything is computed from `f32`
 //! basic operations and `libm`, so every target feeds the kernel the same bits.
 
-use super::cases::Rng;
-use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
-use raykernel::bvh4::nodes4_needed;
+use raykernel::bvh::{BuildOptions, BuilderKind};
 use raykernel::grid::GridOptions;
-use raykernel::kdtree::{self, KdOptions};
-use raykernel::{
-    Accel, Bvh, Bvh4, Grid, KdNode, KdTree, Linear, Node, Node4, Ray, Scalar, Triangle, I16F16,
-};
+use raykernel::kdtree::KdOptions;
+use raykernel::{Accel, AccelKind, AccelVisitor, AnyAccel, Ray, Scalar, Triangle, I16F16};
+use raykernel_testkit::memory::OwnedMemory;
+use raykernel_testkit::Rng;
 use std::path::Path;
 
 /// Heightfield cells per side.
@@ -61,18 +59,43 @@ fn rays() -> Vec<([f32; 3], [f32; 3], f32, f32)> {
         .collect()
 }
 
+/// Every structure, in file order: brute force, the SAH BVH and the 4-wide BVH collapsed from
+/// it, the median and midpoint BVHs (all leaf size 4), the grid and the kd-tree (defaults).
+/// A BVH's file is named after its builder too (`bvh_sah`, `bvh4_sah`).
+fn kinds() -> [AccelKind; 7] {
+    let bvh = |builder| BuildOptions {
+        builder,
+        max_leaf_size: 4,
+        reinsertion: true,
+    };
+    [
+        AccelKind::Linear,
+        AccelKind::Bvh(bvh(BuilderKind::Sah)),
+        AccelKind::Bvh4(bvh(BuilderKind::Sah)),
+        AccelKind::Bvh(bvh(BuilderKind::Median)),
+        AccelKind::Bvh(bvh(BuilderKind::Midpoint)),
+        AccelKind::Grid(GridOptions::DEFAULT),
+        AccelKind::KdTree(KdOptions::DEFAULT),
+    ]
+}
+
 /// Closest hits as hit-file records; a miss (or a ray the kernel rejects) is `+inf, u32::MAX`.
-fn trace<S: Scalar, A: Accel<S>>(accel: &A, rays: &[Option<Ray<S>>]) -> Vec<u8> {
-    let mut out = Vec::with_capacity(8 * rays.len());
-    for r in rays {
-        let (t, prim) = match r.as_ref().and_then(|r| accel.intersect(r)) {
-            Some(hit) => (hit.t.to_f32(), hit.prim),
-            None => (f32::INFINITY, u32::MAX),
-        };
-        out.extend_from_slice(&t.to_le_bytes());
-        out.extend_from_slice(&prim.to_le_bytes());
+struct Trace<'r, S: Scalar>(&'r [Option<Ray<S>>]);
+
+impl<S: Scalar> AccelVisitor<S> for Trace<'_, S> {
+    type Output = Vec<u8>;
+    fn visit<A: Accel<S>>(self, accel: &A) -> Vec<u8> {
+        let mut out = Vec::with_capacity(8 * self.0.len());
+        for r in self.0 {
+            let (t, prim) = match r.as_ref().and_then(|r| accel.intersect(r)) {
+                Some(hit) => (hit.t.to_f32(), hit.prim),
+                None => (f32::INFINITY, u32::MAX),
+            };
+            out.extend_from_slice(&t.to_le_bytes());
+            out.extend_from_slice(&prim.to_le_bytes());
+        }
+        out
     }
-    out
 }
 
 /// Writes `<accel>_<mode>.hits` for every accelerator and both modes into `dir`; returns each
@@ -101,35 +124,17 @@ fn mode<S: Scalar>(dir: &Path, files: &mut Vec<(String, usize)>) -> Result<(), S
         files.push((name, bytes.len() / 8));
         Ok::<(), String>(())
     };
-    let fail = |what: &str, e: raykernel::BuildError| format!("{} {what}: {e}", S::NAME);
-
-    save("linear", trace(&Linear::new(&tris), &rays))?;
-    for builder in BuilderKind::ALL {
-        let mut nodes = vec![Node::<S>::EMPTY; nodes_needed(tris.len())];
-        let mut ids = vec![0u32; tris.len()];
-        let options = BuildOptions {
-            builder,
-            max_leaf_size: 4,
-            reinsertion: true,
+    let fail = |kind: AccelKind, e: raykernel::BuildError| format!("{} {kind}: {e}", S::NAME);
+    for kind in kinds() {
+        let need = kind.memory_needed(&tris).map_err(|e| fail(kind, e))?;
+        let mut memory = OwnedMemory::<S>::sized(need);
+        let accel =
+            AnyAccel::build(kind, &tris, &mut memory.memory()).map_err(|e| fail(kind, e))?;
+        let name = match kind.build_options() {
+            Some(o) => format!("{}_{}", kind.name(), o.builder.name()),
+            None => kind.name().to_string(),
         };
-        let bvh = Bvh::build(&tris, &mut nodes, &mut ids, options).map_err(|e| fail("bvh", e))?;
-        save(&format!("bvh_{}", builder.name()), trace(&bvh, &rays))?;
-        if builder == BuilderKind::Sah {
-            let mut wide = vec![Node4::<S>::EMPTY; nodes4_needed(tris.len())];
-            let bvh4 = Bvh4::collapse(&bvh, &mut wide).map_err(|e| fail("bvh4", e))?;
-            save("bvh4_sah", trace(&bvh4, &rays))?;
-        }
+        save(&name, accel.visit(Trace(&rays)))?;
     }
-    let options = GridOptions::default();
-    let size = Grid::size_for(&tris, options).map_err(|e| fail("grid", e))?;
-    let (mut cells, mut refs) = (vec![0u32; size.cells], vec![0u32; size.refs]);
-    let grid = Grid::build(&tris, &mut cells, &mut refs, options).map_err(|e| fail("grid", e))?;
-    save("grid", trace(&grid, &rays))?;
-    let mut kd_nodes = vec![KdNode::<S>::EMPTY; kdtree::nodes_needed(tris.len())];
-    let mut kd_refs = vec![0u32; kdtree::refs_needed(tris.len())];
-    let options = KdOptions::default();
-    let kd =
-        KdTree::build(&tris, &mut kd_nodes, &mut kd_refs, options).map_err(|e| fail("kd", e))?;
-    save("kdtree", trace(&kd, &rays))?;
     Ok(())
 }

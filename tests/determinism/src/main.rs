@@ -1,4 +1,4 @@
-//! The determinism probe: computes every golden case of `tests/golden/cases.rs` and compares
+//! The determinism probe: computes every golden case of `testkit/src/golden.rs` and compares
 //! it with `tests/golden/kernel_hashes.txt` (embedded at build time, so every target checks
 //! the same file), then writes the closest hits of a generated mesh and ray set, through
 //! every accelerator in both modes, as hit files (`t: f32, prim: u32`, little-endian; the
@@ -11,10 +11,9 @@
 //! line per hit file, and a closing `N passed, M failed` line; the exit code is 1 if any
 //! case failed.
 
-#[path = "../../golden/cases.rs"]
-#[allow(dead_code, clippy::all)]
-mod cases;
 mod hits;
+
+use raykernel_testkit::golden as cases;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

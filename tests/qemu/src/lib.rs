@@ -2,8 +2,7 @@
 //! compiles) and the golden table generated from `tests/golden/kernel_hashes.txt` by build.rs.
 #![no_std]
 
-#[path = "../../golden/cases.rs"]
-pub mod cases;
+pub use raykernel_testkit::golden as cases;
 
 /// The golden table.
 pub mod golden {

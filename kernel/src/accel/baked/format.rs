@@ -5,8 +5,9 @@
 //! then the triangles (nine coordinates each). `docs/BAKED_FORMAT.md` has the field table.
 
 use super::error::BakeError;
-use crate::accel::bvh::Node;
+use crate::accel::bvh::{BuildOptions, Node};
 use crate::accel::bvh4::Node4;
+use crate::accel::AccelKind;
 
 /// The first eight bytes of every baked file.
 pub const MAGIC: [u8; 8] = *b"RKBAKED\0";
@@ -59,6 +60,22 @@ pub enum BakedKind {
 }
 
 impl BakedKind {
+    /// The structure's name, as [`crate::AccelKind::name`] gives it: `bvh` or `bvh4`.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Bvh => "bvh",
+            Self::Bvh4 => "bvh4",
+        }
+    }
+    /// The accelerator a tree of this kind is built as, with `options`.
+    #[must_use]
+    pub const fn accel(self, options: BuildOptions) -> AccelKind {
+        match self {
+            Self::Bvh => AccelKind::Bvh(options),
+            Self::Bvh4 => AccelKind::Bvh4(options),
+        }
+    }
     /// Bytes of one node.
     #[must_use]
     pub const fn node_len(self) -> usize {

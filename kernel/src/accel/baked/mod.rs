@@ -24,9 +24,9 @@ pub use load::{load_bvh, load_bvh4};
 pub use scalar::BakedScalar;
 pub use write::{bake_bvh, bake_bvh4, baked_len};
 
-use crate::accel::bvh::Bvh;
-use crate::accel::bvh4::Bvh4;
-use crate::accel::{Accel, Counters, Nearest};
+use crate::accel::bvh::{Bvh, Node, RefitError, TreeShape};
+use crate::accel::bvh4::{Bvh4, Node4};
+use crate::accel::{Accel, AnyAccel, Counters, Nearest};
 use crate::geom::{Ray, Triangle};
 
 /// A loaded baked tree of either kind.
@@ -47,6 +47,104 @@ impl<'a, S: BakedScalar> Baked<'a, S> {
         match read_header(bytes)?.kind {
             BakedKind::Bvh => load_bvh(bytes).map(Self::Bvh),
             BakedKind::Bvh4 => load_bvh4(bytes).map(Self::Bvh4),
+        }
+    }
+
+    /// The tree inside `accel`, if it is one of the two kinds a baked file holds.
+    #[must_use]
+    pub fn from_any(accel: AnyAccel<'a, S, Triangle<S>>) -> Option<Self> {
+        match accel {
+            AnyAccel::Bvh(t) => Some(Self::Bvh(t)),
+            AnyAccel::Bvh4(t) => Some(Self::Bvh4(t)),
+            AnyAccel::Linear(_) | AnyAccel::Grid(_) | AnyAccel::KdTree(_) => None,
+        }
+    }
+
+    /// The length of this tree's baked file ([`baked_len`]); `None` if the format cannot
+    /// hold it.
+    #[must_use]
+    pub fn baked_len(&self) -> Option<usize> {
+        let nodes = match self {
+            Self::Bvh(t) => t.nodes().len(),
+            Self::Bvh4(t) => t.nodes().len(),
+        };
+        baked_len(self.kind(), nodes, self.prims().len())
+    }
+
+    /// Writes this tree into `out` ([`bake_bvh`], [`bake_bvh4`]); returns the bytes written.
+    ///
+    /// # Errors
+    /// As the writers.
+    pub fn bake(&self, out: &mut [u8]) -> Result<usize, BakeError> {
+        match self {
+            Self::Bvh(t) => bake_bvh(t, out),
+            Self::Bvh4(t) => bake_bvh4(t, out),
+        }
+    }
+
+    /// Which tree this is.
+    #[must_use]
+    pub const fn kind(&self) -> BakedKind {
+        match self {
+            Self::Bvh(_) => BakedKind::Bvh,
+            Self::Bvh4(_) => BakedKind::Bvh4,
+        }
+    }
+
+    /// The triangles, in the order the tree stores them (see [`Baked::is_leaf_order`]).
+    #[must_use]
+    pub fn prims(&self) -> &'a [Triangle<S>] {
+        match self {
+            Self::Bvh(t) => t.prims(),
+            Self::Bvh4(t) => t.prims(),
+        }
+    }
+
+    /// The caller-visible id of each stored triangle, slot by slot.
+    #[must_use]
+    pub fn prim_ids(&self) -> &'a [u32] {
+        match self {
+            Self::Bvh(t) => t.prim_ids(),
+            Self::Bvh4(t) => t.prim_ids(),
+        }
+    }
+
+    /// True if the triangles are stored in leaf order (slot `i` holds id `prim_ids()[i]`),
+    /// false if they are in id order.
+    #[must_use]
+    pub fn is_leaf_order(&self) -> bool {
+        match self {
+            Self::Bvh(t) => t.is_leaf_order(),
+            Self::Bvh4(t) => t.is_leaf_order(),
+        }
+    }
+
+    /// What [`Baked::refit`] needs to know of the tree besides its memory.
+    #[must_use]
+    pub fn shape(&self) -> TreeShape {
+        match self {
+            Self::Bvh(t) => t.shape(),
+            Self::Bvh4(t) => t.shape(),
+        }
+    }
+
+    /// A tree of `kind` and `shape` refitted in place over moved `prims` ([`Bvh::refit`],
+    /// [`Bvh4::refit`]): the binary tree's nodes are `nodes`, the 4-wide tree's `nodes4`; the
+    /// arena of the other kind is not touched.
+    ///
+    /// # Errors
+    /// As the tree's `refit`.
+    pub fn refit(
+        kind: BakedKind,
+        prims: &'a [Triangle<S>],
+        nodes: &'a mut [Node<S>],
+        nodes4: &'a mut [Node4<S>],
+        prim_ids: &'a [u32],
+        shape: TreeShape,
+    ) -> Result<Self, RefitError> {
+        match kind {
+            BakedKind::Bvh => Bvh::refit(prims, nodes, prim_ids, shape).map(Self::Bvh),
+            BakedKind::Bvh4 => Bvh4::refit(prims, nodes4, prim_ids, shape).map(Self::Bvh4),
         }
     }
 }

@@ -1,13 +1,13 @@
-//! Golden cases, shared by the host test (`kernel/tests/golden.rs`) and the on-target tests
-//! (`tests/qemu`): a generated mesh and sphere set, a fixed ray set, and FNV-1a hashes of what
-//! the kernel computes on them. Both sides compile this same file (`#[path]`), so they hash the
-//! same inputs the same way; the expected values live in one place, `kernel_hashes.txt`.
+//! Golden cases, shared by the host test (`kernel/tests/golden.rs`), the host snapshot test,
+//! the determinism probe and the on-target suites (`tests/qemu`, `tests/baremetal`): a generated
+//! mesh and sphere set, a fixed ray set, and FNV-1a hashes of what the kernel computes on them.
+//! Every side links this one module, so they hash the same inputs the same way; the expected
+//! values live in one place, `tests/golden/kernel_hashes.txt`.
 //!
 //! `no_std`, no allocation, no recursion: everything fits the Cortex-M0's 16 KB of RAM.
 //! To add a case (e.g. a render hash), add its name to [`NAMES`] and its computation to
 //! [`compute`], then rewrite the table with `BLESS=1 cargo test -p raykernel --test golden`.
-#![allow(dead_code)]
-
+pub use crate::Rng;
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::render::scenes::{self, SceneData};
 use raykernel::render::{Object, ObjectSlot, RenderMemory, Renderer, Shape, Tile};
@@ -111,35 +111,6 @@ impl Bits for I16F16 {
     }
 }
 
-/// SplitMix64: tiny, seeded, identical on every platform.
-pub struct Rng(u64);
-
-impl Rng {
-    pub const fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    /// Uniform in `[lo, hi)` from 24 random bits (exact conversions only).
-    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * ((self.next_u64() >> 40) as f32 / 16_777_216.0)
-    }
-    /// A direction (not normalised: the kernel normalises) with no tiny length.
-    pub fn dir(&mut self) -> [f32; 3] {
-        loop {
-            let v = [0; 3].map(|_| self.range(-1.0, 1.0));
-            if v[0] * v[0] + v[1] * v[1] + v[2] * v[2] > 0.01 {
-                return v;
-            }
-        }
-    }
-}
-
 fn normalize(p: [f32; 3]) -> [f32; 3] {
     let n = libm::sqrtf(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
     p.map(|x| x / n)
@@ -154,44 +125,9 @@ fn mid(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
 /// Triangle `k` (of [`ICO_TRIS`]) of the level-1 icosphere, as `f32` vertices, scaled and
 /// moved. Computed one at a time, so callers need no second copy of the mesh.
 pub fn ico_triangle(k: usize) -> [[f32; 3]; 3] {
-    const FACES: [[usize; 3]; 20] = [
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
     let phi = (1.0 + libm::sqrtf(5.0)) * 0.5;
-    let v: [[f32; 3]; 12] = [
-        [-1.0, phi, 0.0],
-        [1.0, phi, 0.0],
-        [-1.0, -phi, 0.0],
-        [1.0, -phi, 0.0],
-        [0.0, -1.0, phi],
-        [0.0, 1.0, phi],
-        [0.0, -1.0, -phi],
-        [0.0, 1.0, -phi],
-        [phi, 0.0, -1.0],
-        [phi, 0.0, 1.0],
-        [-phi, 0.0, -1.0],
-        [-phi, 0.0, 1.0],
-    ];
-    let [a, b, c] = FACES[(k / 4) % 20].map(|i| normalize(v[i]));
+    let v = crate::icosphere::corners(0.0, 1.0, phi);
+    let [a, b, c] = crate::icosphere::FACES[(k / 4) % 20].map(|i| normalize(v[i as usize]));
     let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
     let t = match k % 4 {
         0 => [a, ab, ca],
