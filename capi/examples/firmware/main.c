@@ -1,10 +1,14 @@
 /* Firmware example: load a baked mesh from flash through the C interface (no build, no copy)
- * and trace the check grid; print its hash over semihosting and exit with 0, or 1 on an
- * error. Run: qemu-system-arm -machine mps2-an386 -nographic
+ * and trace the check grid, printing its hash; then build the render check scene into static
+ * memory and render its check tile in both number modes, printing each hash and comparing it
+ * with the kernel's (render_golden.h). Output over semihosting; exits with 0, or 1 on an error
+ * or a differing tile. Run: qemu-system-arm -machine mps2-an386 -nographic
  *   -semihosting-config enable=on,target=native -kernel firmware.elf */
 #include <stdint.h>
 #include "raykernel.h"
 #include "grid_hash.h"
+#include "render_golden.h"
+#include "render_scene.h"
 
 extern const uint8_t baked_mesh[];
 extern const uint32_t baked_mesh_len;
@@ -37,6 +41,39 @@ static void __attribute__((noreturn)) exit_with(int failed) {
     }
 }
 
+/* Caller memory of the renderer (any alignment works: rk_renderer_init aligns inside it). */
+static uint8_t render_memory[64 * 1024];
+
+/* Renders the check tile of the render scene in `mode`; 0 if its hash is the kernel's. */
+static int render_check(uint32_t mode, const char *name, uint32_t expect) {
+    static uint8_t tile[3 * RK_TEST_TILE_W * RK_TEST_TILE_H], region[3 * RK_TEST_TILE_W * RK_TEST_TILE_H];
+    RkScene scene = rk_test_scene(mode, 0);
+    size_t bytes = rk_render_bytes(&scene);
+    if (bytes == 0 || bytes > sizeof render_memory) {
+        put("render memory: too small\n");
+        return 1;
+    }
+    RkRenderer renderer;
+    RkSceneError error;
+    RkStatus s = rk_renderer_init(&scene, render_memory, sizeof render_memory, &renderer, &error);
+    if (s == RK_STATUS_OK) {
+        uint32_t h = rk_test_render_hash(&renderer, RK_TEST_TILE_X, RK_TEST_TILE_Y, RK_TEST_TILE_W,
+                                         RK_TEST_TILE_H, RK_TEST_TILE_W, RK_TEST_TILE_H, tile, region, &s);
+        if (s == RK_STATUS_OK) {
+            put("render_tile_hash ");
+            put(name);
+            put(" ");
+            put_hex(h);
+            put(h == expect ? " (the kernel's)\n" : " differs from the kernel's\n");
+            return h != expect;
+        }
+    }
+    put("render: ");
+    put(rk_status_name(s));
+    put("\n");
+    return 1;
+}
+
 int main(void) {
     RkAccel accel;
     RkStatus s = rk_load_baked(baked_mesh, baked_mesh_len, &accel);
@@ -56,5 +93,7 @@ int main(void) {
     put("grid_hash ");
     put_hex(h);
     put("\n");
-    exit_with(0);
+    int failed = render_check(RK_MODE_F32, "f32", RK_TEST_TILE_HASH_F32);
+    failed |= render_check(RK_MODE_FIXED, "fixed", RK_TEST_TILE_HASH_FIXED);
+    exit_with(failed);
 }
