@@ -570,9 +570,8 @@ impl View<'_> {
         }
     }
 
-    /// Object `i`'s floats: nine per triangle or four per sphere.
-    fn data(&self, i: usize) -> Result<&[f32], Failure> {
-        let o = self.objects[i];
+    /// The floats of object `o` (index `i`): nine per triangle or four per sphere.
+    fn data(&self, i: usize, o: &RkObject) -> Result<&[f32], Failure> {
         let per = match o.shape {
             RK_SHAPE_TRIANGLES => 9,
             RK_SHAPE_SPHERES => 4,
@@ -605,7 +604,7 @@ impl View<'_> {
         let (mut triangles, mut spheres, mut accel) = (0usize, 0usize, MemoryNeeded::NONE);
         let too_large = |i| Failure::new(RkStatus::ErrTooLarge, RK_ITEM_OBJECT, i, "count");
         for (i, o) in self.objects.iter().enumerate() {
-            self.data(i)?;
+            self.data(i, o)?;
             let n = o.count as usize;
             let sum = if o.shape == RK_SHAPE_SPHERES {
                 &mut spheres
@@ -756,12 +755,13 @@ fn init_in<S: SpawnScalar, F: AccelFamily<S, Options = BuildOptions>>(
     let (mut t, mut s) = (0usize, 0usize);
     for (slot, o) in objects.iter_mut().zip(view.objects) {
         let n = o.count as usize;
+        // The ranges lie within the arrays (sized by the same counts): `get` never fails.
         let shape = if o.shape == RK_SHAPE_SPHERES {
             s += n;
-            Shape::Spheres(&spheres[s - n..s])
+            Shape::Spheres(spheres.get(s - n..s).unwrap_or_default())
         } else {
             t += n;
-            Shape::Triangles(&tris[t - n..t])
+            Shape::Triangles(tris.get(t - n..t).unwrap_or_default())
         };
         *slot = Object {
             shape,
@@ -839,7 +839,7 @@ fn convert_primitives<S: SpawnScalar>(
 ) -> Result<(), Failure> {
     let (mut tris, mut spheres) = (tris.iter_mut(), spheres.iter_mut());
     for (i, o) in view.objects.iter().enumerate() {
-        let data = view.data(i)?;
+        let data = view.data(i, o)?;
         if o.shape == RK_SHAPE_SPHERES {
             let bad = Failure::new(RkStatus::ErrBadSphere, RK_ITEM_OBJECT, i, "data");
             // The data first: `zip` stops on it without taking a slot past the object's.
@@ -849,7 +849,8 @@ fn convert_primitives<S: SpawnScalar>(
         } else {
             let bad = Failure::new(RkStatus::ErrBadTriangle, RK_ITEM_OBJECT, i, "data");
             for (c, slot) in data.chunks_exact(9).zip(tris.by_ref()) {
-                let v = core::array::from_fn(|k| [c[3 * k], c[3 * k + 1], c[3 * k + 2]]);
+                let c: &[f32; 9] = c.try_into().map_err(|_| bad)?;
+                let v = [[c[0], c[1], c[2]], [c[3], c[4], c[5]], [c[6], c[7], c[8]]];
                 *slot = Triangle::from_f32(v).map_err(|_| bad)?;
             }
         }
