@@ -1,6 +1,6 @@
 //! C interface to raykernel: size the memory, build into it (or load baked bytes in place),
 //! refit after motion, and query closest and any hit, in `f32` or fixed point, on a binary or
-//! 4-wide BVH; and render a scene tile by tile ([`render`]). No allocation and no global state:
+//! 4-wide BVH; and render a scene tile by tile (`render.rs`). No allocation and no global state:
 //! every structure lives in memory the caller passes, and an [`RkAccel`] or [`RkRenderer`] is a
 //! plain value the caller keeps (it holds pointers into that memory, which must outlive it and
 //! not move).

@@ -13,13 +13,13 @@ use core::ffi::{c_char, c_void};
 use core::mem::{align_of, size_of};
 use raykernel::bvh::BuildOptions;
 use raykernel::render::{
-    Camera, Filter, Item, Light, Material, Object, ObjectSlot, Problem, RenderMemory, Renderer,
-    SamplerKind, Scene, SceneError, Settings, Shape, Tile, MAX_LIGHTS,
+    memory_needed, Camera, Filter, Item, Light, Material, Object, ObjectSlot, Problem,
+    RenderMemory, Renderer, SamplerKind, Scene, SceneError, Settings, Shape, Tile, MAX_LIGHTS,
 };
 use raykernel::spawn::SpawnScalar;
 use raykernel::{
     AccelFamily, AccelMemory, BuildError, Bvh4Family, BvhFamily, MemoryNeeded, Node, Node4, Sphere,
-    Triangle, I16F16,
+    Triangle, I16F16, MAX_PRIMS,
 };
 
 /// `RkObject::shape`: a triangle mesh, nine floats per triangle (x y z of three vertices).
@@ -606,6 +606,10 @@ impl View<'_> {
         for (i, o) in self.objects.iter().enumerate() {
             self.data(i, o)?;
             let n = o.count as usize;
+            // The kernel refuses these too; refused here, the sizes below are the kernel's.
+            if n > MAX_PRIMS {
+                return Err(too_large(i));
+            }
             let sum = if o.shape == RK_SHAPE_SPHERES {
                 &mut spheres
             } else {
@@ -769,6 +773,12 @@ fn init_in<S: SpawnScalar, F: AccelFamily<S, Options = BuildOptions>>(
             motion: o.motion,
         };
     }
+    let options = BuildOptions::default();
+    debug_assert_eq!(
+        memory_needed::<S, F>(objects, &options).accel,
+        counts.accel,
+        "`counts` sizes the accelerators as the kernel does"
+    );
     let placeholder = Material::Diffuse { albedo: [0.0; 3] };
     // SAFETY: as above.
     let materials = unsafe { filled(start.add(l.materials), counts.materials, placeholder) };
@@ -822,9 +832,8 @@ fn init_in<S: SpawnScalar, F: AccelFamily<S, Options = BuildOptions>>(
         },
         background: view.scene.background,
     };
-    let renderer =
-        Renderer::<'static, S, F>::new(&scene, settings, BuildOptions::default(), memory)
-            .map_err(|e| failure_of(&e, view.objects))?;
+    let renderer = Renderer::<'static, S, F>::new(&scene, settings, options, memory)
+        .map_err(|e| failure_of(&e, view.objects))?;
     let state = start.cast::<Renderer<'static, S, F>>();
     // SAFETY: offset 0 of the region is reserved for the state, aligned for it (`layout`).
     unsafe { state.write(renderer) };

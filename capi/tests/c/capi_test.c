@@ -181,7 +181,9 @@ static int test_render(void) {
                   "buffer too small");
             free(memory);
         }
-        printf("mode %u: render hash %08x, tile %08x (bvh and bvh4)\n", modes[m], image_hash[m], tile_hash[m]);
+        RkScene scene = rk_test_scene(modes[m], 0);
+        printf("mode %u: render hash %08x, tile %08x (bvh and bvh4); renderer memory %zu bytes\n", modes[m],
+               image_hash[m], tile_hash[m], rk_render_bytes(&scene));
     }
     /* Typed scene errors name the value at fault. */
     RkScene scene = rk_test_scene(RK_MODE_F32, 0);
