@@ -42,7 +42,7 @@ static void __attribute__((noreturn)) exit_with(int failed) {
 }
 
 /* Caller memory of the renderer (any alignment works: rk_renderer_init aligns inside it). */
-static uint8_t render_memory[64 * 1024];
+static uint8_t render_memory[16 * 1024];
 
 /* Renders the check tile of the render scene in `mode`; 0 if its hash is the kernel's. */
 static int render_check(uint32_t mode, const char *name, uint32_t expect) {
