@@ -936,3 +936,159 @@ fn every_status_has_its_own_name() {
     }
     assert_eq!(name(last + 1), "unknown status");
 }
+
+/// A small deterministic generator (xorshift64*).
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+    fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
+    }
+    /// A value that breaks something often: non-finite, huge, zero, negative, out of range.
+    fn float(&mut self) -> f32 {
+        const SPECIAL: [f32; 10] = [
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            0.0,
+            -1.0,
+            1.5,
+            9000.0,
+            -3e38,
+            1e-40,
+            180.0,
+        ];
+        if self.below(2) == 0 {
+            SPECIAL[self.below(SPECIAL.len() as u64) as usize]
+        } else {
+            (self.below(2001) as f32 - 1000.0) / 100.0
+        }
+    }
+}
+
+/// Sets one random field of `c` to a random value (floats anywhere, tags, indices, settings).
+fn mutate(c: &mut CScene, rng: &mut Rng) {
+    let small = |rng: &mut Rng| rng.below(6) as u32;
+    match rng.below(9) {
+        0 => {
+            let o = rng.below(c.floats.len() as u64) as usize;
+            let f = &mut c.floats[o];
+            let i = rng.below(f.len() as u64) as usize;
+            f[i] = rng.float();
+        }
+        1 => {
+            let o = &mut c.objects[rng.below(5) as usize];
+            match rng.below(3) {
+                0 => o.material = small(rng),
+                1 => o.shape = small(rng),
+                _ => o.motion[rng.below(3) as usize] = rng.float(),
+            }
+        }
+        2 => {
+            let m = &mut c.materials[rng.below(5) as usize];
+            match rng.below(3) {
+                0 => m.kind = small(rng),
+                1 => m.exponent = rng.float(),
+                _ => m.color[rng.below(3) as usize] = rng.float(),
+            }
+        }
+        3 => {
+            let n = c.lights.len() as u64;
+            let l = &mut c.lights[rng.below(n) as usize];
+            let k = rng.below(3) as usize;
+            match rng.below(6) {
+                0 => l.kind = small(rng),
+                1 => l.position[k] = rng.float(),
+                2 => l.edge_u[k] = rng.float(),
+                3 => l.edge_v[k] = rng.float(),
+                4 => l.radius = rng.float(),
+                _ => l.color[k] = rng.float(),
+            }
+        }
+        4 => {
+            let cam = &mut c.scene.camera;
+            let k = rng.below(3) as usize;
+            match rng.below(6) {
+                0 => cam.eye[k] = rng.float(),
+                1 => cam.look_at[k] = rng.float(),
+                2 => cam.up[k] = rng.float(),
+                3 => cam.vfov_deg = rng.float(),
+                4 => cam.aperture_radius = rng.float(),
+                _ => cam.focus_distance = rng.float(),
+            }
+        }
+        5 => c.scene.background[rng.below(3) as usize] = rng.float(),
+        6 => {
+            let s = &mut c.scene.settings;
+            match rng.below(7) {
+                0 => s.width = rng.below(40) as u32,
+                1 => s.height = rng.below(40) as u32,
+                2 => s.spp = rng.below(5) as u32,
+                3 => s.max_depth = rng.below(8) as u32,
+                4 => s.sampler = small(rng),
+                5 => s.filter = small(rng),
+                _ => s.seed = rng.next() as u32,
+            }
+        }
+        7 => {
+            // Drop or repeat lights (up to past the limit).
+            let n = rng.below(10) as usize;
+            c.lights = (0..n)
+                .map(|i| c.lights[i % c.lights.len().max(1)])
+                .collect();
+            if c.lights.is_empty() {
+                c.lights = vec![c_light(&LIGHTS[0])];
+            }
+        }
+        _ => c.scene.kind = small(rng),
+    }
+}
+
+#[test]
+fn random_bad_values_give_a_status_never_a_panic() {
+    // Any panic inside the C functions aborts this test process: reaching the end is the check.
+    let data = test_scene();
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let (mut accepted, mut refused) = (0, 0);
+    for round in 0..6000 {
+        let mode = if round % 2 == 0 {
+            RK_MODE_F32
+        } else {
+            RK_MODE_FIXED
+        };
+        let mut c = CScene::new(&data, mode, 0);
+        for _ in 0..1 + rng.below(3) {
+            mutate(&mut c, &mut rng);
+        }
+        let scene = *c.point();
+        // SAFETY: the scene's arrays are valid for their counts.
+        let bytes = unsafe { rk_render_bytes(&scene) };
+        let mut memory = Memory::new(bytes.max(1), 0);
+        match init(&scene, &mut memory, bytes) {
+            Ok(r) => {
+                accepted += 1;
+                let (w, h) = (scene.settings.width.min(4), scene.settings.height.min(4));
+                let mut px = vec![0u8; 3 * (w * h) as usize];
+                // SAFETY: `r` is initialised, its memory alive; `px` holds `px.len()` bytes.
+                let s = unsafe { rk_render_tile(&r, 0, 0, w, h, px.as_mut_ptr(), px.len()) };
+                assert_eq!(s, RkStatus::Ok, "round {round}");
+            }
+            Err((s, _)) => {
+                refused += 1;
+                assert_ne!(s, RkStatus::Ok);
+            }
+        }
+    }
+    println!("accepted {accepted}, refused {refused}");
+    // Both outcomes occur, so the mutations reach the checks and the renders.
+    assert!(
+        accepted > 100 && refused > 100,
+        "accepted {accepted}, refused {refused}"
+    );
+}
