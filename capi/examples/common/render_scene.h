@@ -1,6 +1,6 @@
 /* The render check: a small scene (a floor, a glossy wall, a moving mirror sphere, two diffuse
  * spheres, a glowing triangle, a rectangle and a point light; thin-lens camera) as C structs,
- * the same scene capi/tests/render.rs gives the kernel's renderer, and the FNV-1a hash of a
+ * the same scene capi/tests/common/mod.rs gives the kernel's renderer, and the FNV-1a hash of a
  * rendered region. render_golden.h holds the hashes that test computed: C on any target can be
  * checked against the Rust side. No allocation (firmware): regions go through the caller's
  * buffers. Compile with -ffp-contract=off like every caller of the kernel. */
