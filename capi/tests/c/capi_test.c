@@ -1,13 +1,15 @@
 /* Host test of the C interface (gcc): every status named, builds in both modes and both tree
  * kinds answering alike, typed errors for bad arguments, refit equal to a rebuild, rendering
- * the check scene in tiles with the kernel's bytes (render_golden.h) and typed scene errors,
- * and, given a baked file (argv[1]), loading it in place and printing the check grid's hash
- * (compared with argv[2] when given: the hash `raykernel bake` printed for the tree it built).
+ * the check scene in tiles (also from several threads at once) with the kernel's bytes
+ * (render_golden.h) and typed scene errors, and, given a baked file (argv[1]), loading it in
+ * place and printing the check grid's hash (compared with argv[2] when given: the hash
+ * `raykernel bake` printed for the tree it built).
  * Build: gcc -std=c11 -ffp-contract=off -I capi/include -I capi/examples/common
  *        capi/tests/c/capi_test.c target/debug/libraykernel_c.a -lpthread -ldl -lm */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <threads.h>
 #include "raykernel.h"
 #include "grid_hash.h"
 #include "render_golden.h"
@@ -226,6 +228,59 @@ static int test_render(void) {
     return 0;
 }
 
+enum { THREADS = 4 };
+
+typedef struct {
+    const RkRenderer *renderer;
+    int first_row;
+    uint8_t *image;
+    RkStatus status;
+} RowJob;
+
+/* Renders every THREADS-th row, from `first_row`, straight into its place in the image. */
+static int render_rows(void *arg) {
+    RowJob *job = arg;
+    job->status = RK_STATUS_OK;
+    for (uint32_t y = (uint32_t)job->first_row; y < RK_TEST_HEIGHT; y += THREADS) {
+        uint8_t *row = job->image + 3u * y * RK_TEST_WIDTH;
+        RkStatus s = rk_render_tile(job->renderer, 0, y, RK_TEST_WIDTH, 1, row, 3u * RK_TEST_WIDTH);
+        if (s != RK_STATUS_OK) {
+            job->status = s;
+        }
+    }
+    return 0;
+}
+
+/* One renderer, tiles rendered by several threads at once: the kernel's image. */
+static int test_render_threads(void) {
+    static uint8_t image[3 * RK_TEST_WIDTH * RK_TEST_HEIGHT];
+    RkScene scene = rk_test_scene(RK_MODE_FIXED, RK_KIND_BVH4);
+    void *memory;
+    RkRenderer r;
+    RkSceneError e;
+    RkStatus s = render_init(&scene, &memory, &r, &e);
+    CHECK(s == RK_STATUS_OK, "render init: %s", rk_status_name(s));
+    thrd_t threads[THREADS];
+    RowJob jobs[THREADS];
+    for (int t = 0; t < THREADS; t++) {
+        jobs[t] = (RowJob){&r, t, image, RK_STATUS_OK};
+        CHECK(thrd_create(&threads[t], render_rows, &jobs[t]) == thrd_success, "thread %d", t);
+    }
+    for (int t = 0; t < THREADS; t++) {
+        thrd_join(threads[t], NULL);
+        CHECK(jobs[t].status == RK_STATUS_OK, "thread %d: %s", t, rk_status_name(jobs[t].status));
+    }
+    uint32_t h = 0x811c9dc5u;
+    for (size_t i = 0; i < sizeof image; i++) {
+        h = rk_fnv1a(h, image[i], 1);
+    }
+    CHECK(h == RK_TEST_IMAGE_HASH_FIXED, "%d threads: image hash %08x, the kernel's %08x", THREADS, h,
+          RK_TEST_IMAGE_HASH_FIXED);
+    printf("render on %d threads at once: the kernel's image\n", THREADS);
+    free(memory);
+    return 0;
+}
+
 static int test_baked(const char *path, const char *expect) {
     FILE *f = fopen(path, "rb");
     CHECK(f != NULL, "cannot open %s", path);
@@ -262,7 +317,7 @@ static int test_baked(const char *path, const char *expect) {
 }
 
 int main(int argc, char **argv) {
-    if (test_names() || test_builds_and_errors() || test_render()) {
+    if (test_names() || test_builds_and_errors() || test_render() || test_render_threads()) {
         return 1;
     }
     if (argc > 1 && test_baked(argv[1], argc > 2 ? argv[2] : NULL)) {
