@@ -5,6 +5,13 @@
 //! `golden_header_matches_the_kernel` regenerates from the kernel
 //! (`BLESS=1 cargo test -p raykernel-c --test render` rewrites it).
 
+#![cfg(all(
+    feature = "render-f32",
+    feature = "render-fixed",
+    feature = "render-bvh",
+    feature = "render-bvh4"
+))] // renders in every mode and kind
+
 mod common;
 
 use common::*;

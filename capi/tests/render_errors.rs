@@ -2,6 +2,13 @@
 //! small memory, bad tiles and buffers, and random bad values anywhere in the scene (a status,
 //! never a panic).
 
+#![cfg(all(
+    feature = "render-f32",
+    feature = "render-fixed",
+    feature = "render-bvh",
+    feature = "render-bvh4"
+))] // renders in every mode and kind
+
 mod common;
 
 use common::*;

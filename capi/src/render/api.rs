@@ -126,11 +126,21 @@ pub unsafe extern "C" fn rk_render_tile(
     };
     // SAFETY (each arm): the pointer is the renderer `init` wrote into the caller's memory,
     // which is still valid and unmodified (contract); it is only read.
+    // The guards are constants: a pair the features leave out is not linked (and never stored).
     let rendered = match handle.renderer {
-        AnyRenderer::F32Bvh(r) => unsafe { &*r }.render_tile_srgb8(tile, out),
-        AnyRenderer::F32Bvh4(r) => unsafe { &*r }.render_tile_srgb8(tile, out),
-        AnyRenderer::FixedBvh(r) => unsafe { &*r }.render_tile_srgb8(tile, out),
-        AnyRenderer::FixedBvh4(r) => unsafe { &*r }.render_tile_srgb8(tile, out),
+        AnyRenderer::F32Bvh(r) if Which::F32Bvh.linked() => {
+            unsafe { &*r }.render_tile_srgb8(tile, out)
+        }
+        AnyRenderer::F32Bvh4(r) if Which::F32Bvh4.linked() => {
+            unsafe { &*r }.render_tile_srgb8(tile, out)
+        }
+        AnyRenderer::FixedBvh(r) if Which::FixedBvh.linked() => {
+            unsafe { &*r }.render_tile_srgb8(tile, out)
+        }
+        AnyRenderer::FixedBvh4(r) if Which::FixedBvh4.linked() => {
+            unsafe { &*r }.render_tile_srgb8(tile, out)
+        }
+        _ => return RkStatus::ErrNotInitialised,
     };
     match rendered {
         Ok(_) => RkStatus::Ok,

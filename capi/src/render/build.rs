@@ -78,10 +78,20 @@ pub(super) fn init(
     let counts = view.counts()?;
     let memory = memory.cast::<u8>();
     Ok(match view.which()? {
-        Which::F32Bvh => AnyRenderer::F32Bvh(init_in(&view, &counts, memory, bytes)?),
-        Which::F32Bvh4 => AnyRenderer::F32Bvh4(init_in(&view, &counts, memory, bytes)?),
-        Which::FixedBvh => AnyRenderer::FixedBvh(init_in(&view, &counts, memory, bytes)?),
-        Which::FixedBvh4 => AnyRenderer::FixedBvh4(init_in(&view, &counts, memory, bytes)?),
+        // `which` gives linked pairs only; the constant guards drop the others from the binary.
+        w @ Which::F32Bvh if w.linked() => {
+            AnyRenderer::F32Bvh(init_in(&view, &counts, memory, bytes)?)
+        }
+        w @ Which::F32Bvh4 if w.linked() => {
+            AnyRenderer::F32Bvh4(init_in(&view, &counts, memory, bytes)?)
+        }
+        w @ Which::FixedBvh if w.linked() => {
+            AnyRenderer::FixedBvh(init_in(&view, &counts, memory, bytes)?)
+        }
+        w @ Which::FixedBvh4 if w.linked() => {
+            AnyRenderer::FixedBvh4(init_in(&view, &counts, memory, bytes)?)
+        }
+        _ => return Err(Failure::scene(RkStatus::ErrBadArgument, "kind")),
     })
 }
 

@@ -6,12 +6,30 @@ use crate::{RkStatus, RK_KIND_BVH, RK_KIND_BVH4, RK_MODE_F32, RK_MODE_FIXED};
 use raykernel::{MemoryNeeded, MAX_PRIMS};
 
 /// The mode and accelerator family a scene names.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, PartialEq, Eq)]
 pub(super) enum Which {
     F32Bvh,
     F32Bvh4,
     FixedBvh,
     FixedBvh4,
+}
+
+impl Which {
+    /// Whether the crate's features (`render-f32`, `render-fixed`, `render-bvh`,
+    /// `render-bvh4`) link this pair. A constant: code for a pair left out is dead, so neither
+    /// its build nor its renderer reaches the binary.
+    pub(super) const fn linked(self) -> bool {
+        let (mode, kind) = match self {
+            Self::F32Bvh => (cfg!(feature = "render-f32"), cfg!(feature = "render-bvh")),
+            Self::F32Bvh4 => (cfg!(feature = "render-f32"), cfg!(feature = "render-bvh4")),
+            Self::FixedBvh => (cfg!(feature = "render-fixed"), cfg!(feature = "render-bvh")),
+            Self::FixedBvh4 => (
+                cfg!(feature = "render-fixed"),
+                cfg!(feature = "render-bvh4"),
+            ),
+        };
+        mode && kind
+    }
 }
 
 /// The caller's scene, its arrays as slices (valid for the call).
@@ -77,18 +95,29 @@ pub(super) struct Counts {
 }
 
 impl View<'_> {
+    /// The mode and family; an unknown value is a bad argument, and so is a pair the crate's
+    /// features leave out (named as the kind).
     pub(super) fn which(&self) -> Result<Which, Failure> {
-        let bvh4 = match self.scene.kind {
-            0 | RK_KIND_BVH4 => true,
-            RK_KIND_BVH => false,
-            _ => return Err(Failure::scene(RkStatus::ErrBadArgument, "kind")),
+        let bvh4 = self.bvh4()?;
+        let which = match (self.scene.mode, bvh4) {
+            (RK_MODE_F32, false) => Which::F32Bvh,
+            (RK_MODE_F32, true) => Which::F32Bvh4,
+            (RK_MODE_FIXED, false) => Which::FixedBvh,
+            (RK_MODE_FIXED, true) => Which::FixedBvh4,
+            _ => return Err(Failure::scene(RkStatus::ErrBadArgument, "mode")),
         };
-        match (self.scene.mode, bvh4) {
-            (RK_MODE_F32, false) => Ok(Which::F32Bvh),
-            (RK_MODE_F32, true) => Ok(Which::F32Bvh4),
-            (RK_MODE_FIXED, false) => Ok(Which::FixedBvh),
-            (RK_MODE_FIXED, true) => Ok(Which::FixedBvh4),
-            _ => Err(Failure::scene(RkStatus::ErrBadArgument, "mode")),
+        if !which.linked() {
+            return Err(Failure::scene(RkStatus::ErrBadArgument, "kind"));
+        }
+        Ok(which)
+    }
+
+    /// Whether the scene names the 4-wide BVH (the default) rather than the binary one.
+    fn bvh4(&self) -> Result<bool, Failure> {
+        match self.scene.kind {
+            0 | RK_KIND_BVH4 => Ok(true),
+            RK_KIND_BVH => Ok(false),
+            _ => Err(Failure::scene(RkStatus::ErrBadArgument, "kind")),
         }
     }
 
@@ -122,7 +151,8 @@ impl View<'_> {
     /// The counts, and the accelerator memory as the kernel's `memory_needed` gives it for a
     /// BVH (or 4-wide BVH) per object and a top-level BVH over two objects or more.
     pub(super) fn counts(&self) -> Result<Counts, Failure> {
-        let bvh4 = matches!(self.which()?, Which::F32Bvh4 | Which::FixedBvh4);
+        self.which()?;
+        let bvh4 = self.bvh4()?;
         let (mut triangles, mut spheres, mut accel) = (0usize, 0usize, MemoryNeeded::NONE);
         let too_large = |i| Failure::new(RkStatus::ErrTooLarge, RK_ITEM_OBJECT, i, "count");
         for (i, o) in self.objects.iter().enumerate() {
