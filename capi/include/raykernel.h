@@ -618,7 +618,8 @@ struct RkRenderSettings rk_render_settings_default(void);
 /**
  * Bytes of memory `rk_renderer_init` needs for `scene` (any alignment: 127 bytes of it are
  * slack for aligning), or 0 if `scene` is null or unusable before any value is checked
- * (unknown mode, kind or shape, a null array, sizes beyond the address space).
+ * (unknown mode, kind or shape, a mode and kind the crate's features leave out, a null array,
+ * sizes beyond the address space).
  */
 size_t rk_render_bytes(const struct RkScene *scene);
 

@@ -49,7 +49,11 @@ static int render_check(uint32_t mode, const char *name, uint32_t expect) {
     static uint8_t tile[3 * RK_TEST_TILE_W * RK_TEST_TILE_H], region[3 * RK_TEST_TILE_W * RK_TEST_TILE_H];
     RkScene scene = rk_test_scene(mode, 0);
     size_t bytes = rk_render_bytes(&scene);
-    if (bytes == 0 || bytes > sizeof render_memory) {
+    if (bytes == 0) {
+        put("rk_render_bytes: scene unusable, or its mode and kind not linked\n");
+        return 1;
+    }
+    if (bytes > sizeof render_memory) {
         put("render memory: too small\n");
         return 1;
     }

@@ -34,7 +34,8 @@ pub extern "C" fn rk_render_settings_default() -> RkRenderSettings {
 
 /// Bytes of memory `rk_renderer_init` needs for `scene` (any alignment: 127 bytes of it are
 /// slack for aligning), or 0 if `scene` is null or unusable before any value is checked
-/// (unknown mode, kind or shape, a null array, sizes beyond the address space).
+/// (unknown mode, kind or shape, a mode and kind the crate's features leave out, a null array,
+/// sizes beyond the address space).
 #[no_mangle]
 pub unsafe extern "C" fn rk_render_bytes(scene: *const RkScene) -> usize {
     let Ok(view) = view(scene) else {
