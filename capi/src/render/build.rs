@@ -162,11 +162,10 @@ fn init_in<S: SpawnScalar, F: AccelFamily<S, Options = BuildOptions>>(
             t += n;
             Shape::Triangles(tris.get(t - n..t).unwrap_or_default())
         };
-        *slot = Object {
-            shape,
-            material: o.material,
-            motion: o.motion,
-        };
+        // From `Object::new`: fields the C struct does not have keep their defaults.
+        let mut object = Object::new(shape, o.material);
+        object.motion = o.motion;
+        *slot = object;
     }
     let options = BuildOptions::default();
     debug_assert_eq!(

@@ -5,67 +5,54 @@
 
 use core::ffi::c_void;
 use raykernel::bvh::BuildOptions;
-use raykernel::render::scenes::{ObjectData, SceneData, ShapeRange, SphereData};
 use raykernel::render::{
     memory_needed, Camera, Filter, Light, Material, Object, ObjectSlot, RenderMemory, Renderer,
-    SamplerKind, Settings, Shape,
+    Rgb, SamplerKind, Scene, Settings, Shape,
 };
 use raykernel::spawn::SpawnScalar;
 use raykernel::{AccelMemory, Bvh4Family, Node, Node4, Sphere, Triangle};
 use raykernel_c::*;
 
-// The test scene: `examples/common/render_scene.h` is the same scene in C.
-pub const TRIANGLES: [[[f32; 3]; 3]; 5] = [
-    // Floor (y = 0).
+/// An object's primitives as `f32` data.
+#[derive(Clone, Copy, Debug)]
+pub enum TestShape {
+    /// Three vertices each.
+    Triangles(&'static [[[f32; 3]; 3]]),
+    /// Centre x y z and radius each (the C layout).
+    Spheres(&'static [[f32; 4]]),
+}
+
+/// An object of the test scene.
+#[derive(Clone, Copy, Debug)]
+pub struct TestObject {
+    pub shape: TestShape,
+    pub material: u32,
+    pub motion: [f32; 3],
+}
+
+/// The test scene in the kernel's terms (geometry as `f32` data).
+#[derive(Clone, Debug)]
+pub struct TestScene {
+    pub objects: Vec<TestObject>,
+    pub materials: Vec<Material>,
+    pub lights: Vec<Light>,
+    pub camera: Camera,
+    pub background: Rgb,
+    pub settings: Settings,
+}
+
+const FLOOR: [[[f32; 3]; 3]; 2] = [
     [[-2.0, 0.0, -2.0], [2.0, 0.0, 2.0], [2.0, 0.0, -2.0]],
     [[-2.0, 0.0, -2.0], [-2.0, 0.0, 2.0], [2.0, 0.0, 2.0]],
-    // Back wall (z = -2).
+];
+const WALL: [[[f32; 3]; 3]; 2] = [
     [[-2.0, 0.0, -2.0], [2.0, 0.0, -2.0], [2.0, 2.0, -2.0]],
     [[-2.0, 0.0, -2.0], [2.0, 2.0, -2.0], [-2.0, 2.0, -2.0]],
-    // A glowing triangle in front of the wall.
-    [[1.0, 0.9, -1.5], [1.7, 0.9, -1.5], [1.35, 1.5, -1.5]],
 ];
-pub const SPHERES: [SphereData; 3] = [
-    SphereData {
-        center: [-0.6, 0.5, 0.0],
-        radius: 0.5,
-    },
-    SphereData {
-        center: [0.7, 0.35, 0.4],
-        radius: 0.35,
-    },
-    SphereData {
-        center: [0.15, 0.15, 1.1],
-        radius: 0.15,
-    },
-];
-pub const OBJECTS: [ObjectData; 5] = [
-    ObjectData {
-        shape: ShapeRange::Triangles { first: 0, count: 2 },
-        material: 0,
-        motion: [0.0; 3],
-    },
-    ObjectData {
-        shape: ShapeRange::Triangles { first: 2, count: 2 },
-        material: 1,
-        motion: [0.0; 3],
-    },
-    ObjectData {
-        shape: ShapeRange::Spheres { first: 0, count: 1 },
-        material: 2,
-        motion: [0.25, 0.0, 0.0],
-    },
-    ObjectData {
-        shape: ShapeRange::Spheres { first: 1, count: 2 },
-        material: 4,
-        motion: [0.0; 3],
-    },
-    ObjectData {
-        shape: ShapeRange::Triangles { first: 4, count: 1 },
-        material: 3,
-        motion: [0.0; 3],
-    },
-];
+const GLOW: [[[f32; 3]; 3]; 1] = [[[1.0, 0.9, -1.5], [1.7, 0.9, -1.5], [1.35, 1.5, -1.5]]];
+const MIRROR_BALL: [[f32; 4]; 1] = [[-0.6, 0.5, 0.0, 0.5]];
+const BALLS: [[f32; 4]; 2] = [[0.7, 0.35, 0.4, 0.35], [0.15, 0.15, 1.1, 0.15]];
+
 pub const MATERIALS: [Material; 5] = [
     Material::Diffuse {
         albedo: [0.7, 0.7, 0.7],
@@ -97,14 +84,26 @@ pub const LIGHTS: [Light; 2] = [
     },
 ];
 
-pub fn test_scene() -> SceneData<'static> {
-    SceneData {
-        name: "capi",
-        triangles: &TRIANGLES,
-        spheres: &SPHERES,
-        objects: &OBJECTS,
-        materials: &MATERIALS,
-        lights: &LIGHTS,
+/// The test scene: a floor, a glossy wall, a moving mirror ball, two diffuse balls and a
+/// glowing triangle, under a rectangle and a point light, through a thin lens.
+// Every field is named, but the kernel's `Settings` may gain fields: they keep their defaults.
+#[allow(clippy::needless_update)]
+pub fn test_scene() -> TestScene {
+    let object = |shape, material, motion| TestObject {
+        shape,
+        material,
+        motion,
+    };
+    TestScene {
+        objects: vec![
+            object(TestShape::Triangles(&FLOOR), 0, [0.0; 3]),
+            object(TestShape::Triangles(&WALL), 1, [0.0; 3]),
+            object(TestShape::Spheres(&MIRROR_BALL), 2, [0.25, 0.0, 0.0]),
+            object(TestShape::Spheres(&BALLS), 4, [0.0; 3]),
+            object(TestShape::Triangles(&GLOW), 3, [0.0; 3]),
+        ],
+        materials: MATERIALS.to_vec(),
+        lights: LIGHTS.to_vec(),
         camera: Camera {
             eye: [0.0, 1.2, 4.5],
             look_at: [0.0, 0.6, 0.0],
@@ -122,6 +121,7 @@ pub fn test_scene() -> SceneData<'static> {
             sampler: SamplerKind::Stratified,
             filter: Filter::Tent,
             seed: 7,
+            ..Settings::default()
         },
     }
 }
@@ -135,19 +135,55 @@ pub fn fnv1a(bytes: &[u8]) -> u32 {
     })
 }
 
+/// One object's primitives converted to mode `S`.
+enum Prims<S: SpawnScalar> {
+    Triangles(Vec<Triangle<S>>),
+    Spheres(Vec<Sphere<S>>),
+}
+
 /// The kernel's render of `data` (4-wide BVHs), whole image, sRGB.
-pub fn kernel_render<S: SpawnScalar>(data: &SceneData<'_>) -> Vec<u8> {
-    let zero = [S::ZERO; 3];
-    let mut tris = vec![Triangle { v: [zero; 3] }; data.triangles.len()];
-    let sphere = Sphere {
-        center: zero,
-        radius: S::ZERO,
+pub fn kernel_render<S: SpawnScalar>(data: &TestScene) -> Vec<u8> {
+    let coord = |x: f32| S::coord_from_f32(x).expect("the test scene is in range");
+    let prims: Vec<Prims<S>> = data
+        .objects
+        .iter()
+        .map(|o| match o.shape {
+            TestShape::Triangles(t) => Prims::Triangles(
+                t.iter()
+                    .map(|v| Triangle::from_f32(*v).expect("the test scene is in range"))
+                    .collect(),
+            ),
+            TestShape::Spheres(s) => Prims::Spheres(
+                s.iter()
+                    .map(|c| Sphere {
+                        center: [coord(c[0]), coord(c[1]), coord(c[2])],
+                        radius: coord(c[3]),
+                    })
+                    .collect(),
+            ),
+        })
+        .collect();
+    let objects: Vec<Object<'_, S>> = data
+        .objects
+        .iter()
+        .zip(&prims)
+        .map(|(o, p)| {
+            let shape = match p {
+                Prims::Triangles(t) => Shape::Triangles(t),
+                Prims::Spheres(s) => Shape::Spheres(s),
+            };
+            let mut object = Object::new(shape, o.material);
+            object.motion = o.motion;
+            object
+        })
+        .collect();
+    let scene = Scene {
+        objects: &objects,
+        materials: &data.materials,
+        lights: &data.lights,
+        camera: data.camera,
+        background: data.background,
     };
-    let mut spheres = vec![sphere; data.spheres.len()];
-    data.triangles_into(&mut tris).unwrap();
-    data.spheres_into(&mut spheres).unwrap();
-    let mut objects = vec![Object::new(Shape::Triangles(&[]), 0); data.objects.len()];
-    let scene = data.scene(&tris, &spheres, &mut objects).unwrap();
     let options = BuildOptions::default();
     let need = memory_needed::<S, Bvh4Family>(scene.objects, &options);
     let mut slots = vec![ObjectSlot::<S, Bvh4Family>::EMPTY; need.objects];
@@ -163,10 +199,11 @@ pub fn kernel_render<S: SpawnScalar>(data: &SceneData<'_>) -> Vec<u8> {
             words: &mut words,
         },
     };
-    let r = Renderer::new(&scene, data.settings, options, memory).unwrap();
+    let r = Renderer::new(&scene, data.settings, options, memory).expect("the test scene is valid");
     let s = data.settings;
     let mut out = vec![0u8; 3 * (s.width * s.height) as usize];
-    r.render_srgb8(&mut out).unwrap();
+    r.render_srgb8(&mut out)
+        .expect("the whole image is a valid tile");
     out
 }
 
@@ -180,21 +217,13 @@ pub struct CScene {
 }
 
 impl CScene {
-    pub fn new(data: &SceneData<'_>, mode: u32, kind: u32) -> Self {
+    pub fn new(data: &TestScene, mode: u32, kind: u32) -> Self {
         let floats: Vec<Vec<f32>> = data
             .objects
             .iter()
             .map(|o| match o.shape {
-                ShapeRange::Triangles { first, count } => data.triangles
-                    [first as usize..(first + count) as usize]
-                    .iter()
-                    .flat_map(|t| t.iter().flatten().copied())
-                    .collect(),
-                ShapeRange::Spheres { first, count } => data.spheres
-                    [first as usize..(first + count) as usize]
-                    .iter()
-                    .flat_map(|s| [s.center[0], s.center[1], s.center[2], s.radius])
-                    .collect(),
+                TestShape::Triangles(t) => t.iter().flatten().flatten().copied().collect(),
+                TestShape::Spheres(s) => s.iter().flatten().copied().collect(),
             })
             .collect();
         let objects = data
@@ -203,13 +232,13 @@ impl CScene {
             .zip(&floats)
             .map(|(o, f)| {
                 let (shape, count) = match o.shape {
-                    ShapeRange::Triangles { count, .. } => (RK_SHAPE_TRIANGLES, count),
-                    ShapeRange::Spheres { count, .. } => (RK_SHAPE_SPHERES, count),
+                    TestShape::Triangles(t) => (RK_SHAPE_TRIANGLES, t.len()),
+                    TestShape::Spheres(s) => (RK_SHAPE_SPHERES, s.len()),
                 };
                 RkObject {
                     shape,
                     material: o.material,
-                    count,
+                    count: count as u32,
                     data: f.as_ptr(),
                     motion: o.motion,
                 }
