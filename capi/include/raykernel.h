@@ -611,7 +611,7 @@ enum RkStatus rk_intersect(const struct RkAccel *accel, const struct RkRay *ray,
 enum RkStatus rk_occluded(const struct RkAccel *accel, const struct RkRay *ray, bool *occluded);
 
 /**
- * The kernel's defaults: 64 × 64 pixels, 16 spp, depth 4, stratified, box filter, seed 0.
+ * The kernel's default settings (its `Settings::default()`), to start from.
  */
 struct RkRenderSettings rk_render_settings_default(void);
 

@@ -10,7 +10,7 @@ use core::mem::{align_of, size_of};
 use raykernel::render::{Filter, Renderer, SamplerKind, Settings, Tile};
 use raykernel::{Bvh4Family, BvhFamily, I16F16};
 
-/// The kernel's defaults: 64 × 64 pixels, 16 spp, depth 4, stratified, box filter, seed 0.
+/// The kernel's default settings (its `Settings::default()`), to start from.
 #[no_mangle]
 pub extern "C" fn rk_render_settings_default() -> RkRenderSettings {
     let s = Settings::default();
