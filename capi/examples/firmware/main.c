@@ -1,14 +1,15 @@
 /* Firmware example: load a baked mesh from flash through the C interface (no build, no copy)
  * and trace the check grid, printing its hash; then build the render check scene into static
  * memory and render its check tile in both number modes, printing each hash and comparing it
- * with the kernel's (render_golden.h). Output over semihosting; exits with 0, or 1 on an error
- * or a differing tile. Run: qemu-system-arm -machine mps2-an386 -nographic
+ * with the kernel's (render_golden.h), and the stack each part used. Output over semihosting;
+ * exits with 0, or 1 on an error or a differing tile. Run: qemu-system-arm -machine mps2-an386 -nographic
  *   -semihosting-config enable=on,target=native -kernel firmware.elf */
 #include <stdint.h>
 #include "raykernel.h"
 #include "grid_hash.h"
 #include "render_golden.h"
 #include "render_scene.h"
+#include "stack_paint.h"
 
 extern const uint8_t baked_mesh[];
 extern const uint32_t baked_mesh_len;
@@ -23,6 +24,17 @@ static int semihost(int op, const void *arg) {
 
 static void put(const char *s) {
     semihost(0x04, s); /* SYS_WRITE0 */
+}
+
+static void put_dec(uint32_t x) {
+    char s[11];
+    int i = 10;
+    s[i] = 0;
+    do {
+        s[--i] = (char)('0' + x % 10u);
+        x /= 10u;
+    } while (x != 0);
+    put(&s[i]);
 }
 
 static void put_hex(uint32_t x) {
@@ -97,7 +109,13 @@ int main(void) {
     put("grid_hash ");
     put_hex(h);
     put("\n");
+    put("stack used by load + trace: ");
+    put_dec(stack_used());
+    put(" bytes\n");
     int failed = render_check(RK_MODE_F32, "f32", RK_TEST_TILE_HASH_F32);
     failed |= render_check(RK_MODE_FIXED, "fixed", RK_TEST_TILE_HASH_FIXED);
+    put("stack used with init + render: ");
+    put_dec(stack_used());
+    put(" bytes\n");
     exit_with(failed);
 }
