@@ -80,7 +80,11 @@ static int render_check(uint32_t mode, const char *name, uint32_t expect) {
             put(name);
             put(" ");
             put_hex(h);
-            put(h == expect ? " (the kernel's)\n" : " differs from the kernel's\n");
+            put(h == expect ? " (the kernel's), renderer memory " : " differs from the kernel's\n");
+            if (h == expect) {
+                put_dec((uint32_t)bytes);
+                put(" bytes\n");
+            }
             return h != expect;
         }
     }
