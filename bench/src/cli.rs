@@ -67,6 +67,10 @@ pub struct BenchArgs {
     /// Rays per set in the scale sweep [default: 262144, or 16384 with --quick].
     #[arg(long, value_name = "N", value_parser = RangedU64ValueParser::<usize>::new().range(1..))]
     pub scale_rays: Option<usize>,
+    /// Spheres of the objects comparison (each its own object, against one object holding
+    /// them); `0` skips it [default: 100000, or 10000 with --quick].
+    #[arg(long, value_name = "N")]
+    pub objects: Option<usize>,
     /// Skip the image-convergence renders (RMSE against time per sampler).
     #[arg(long)]
     pub no_images: bool,
@@ -135,6 +139,9 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport, Error> {
             let threads = std::thread::available_parallelism().map_or(1, usize::from);
             crate::images::ImageOptions::new(args.quick, args.image_spp, threads)
         }),
+        objects: args
+            .objects
+            .unwrap_or(if args.quick { 10_000 } else { 100_000 }),
         quick: args.quick,
         command: command_line(),
     };

@@ -156,6 +156,24 @@ pub fn figures(r: &BenchResults) -> Vec<Figure> {
             push("icosphere-256", "-", &contender, figure, value);
         }
     }
+    for x in &r.objects {
+        let contender = format!("raykernel render objects {}", x.mode);
+        let scene = format!("spheres-{}", x.spheres);
+        for (figure, value) in [
+            ("many_build_ms", x.many_build_ms),
+            ("one_build_ms", x.one_build_ms),
+            ("many_render_ms", x.many_render_ms),
+            ("one_render_ms", x.one_render_ms),
+            ("render_ratio", x.render_ratio),
+            ("differing_bytes", x.differing_bytes as f64),
+            (
+                "differing_bytes_brute_force",
+                x.differing_bytes_brute_force as f64,
+            ),
+        ] {
+            push(&scene, "-", &contender, figure, value);
+        }
+    }
     for x in &r.images {
         let contender = format!("raykernel render {} {}spp", x.sampler, x.spp);
         push(&x.scene, "-", &contender, "seconds", x.seconds);

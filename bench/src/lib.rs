@@ -32,6 +32,7 @@ pub mod figures;
 pub mod images;
 pub mod machine;
 pub mod mt;
+pub mod objects;
 pub mod ours;
 pub mod overhead;
 pub mod peers;
@@ -85,6 +86,8 @@ pub struct BenchConfig {
     pub scale: scale::ScaleOptions,
     /// The image-convergence renders (`None`: skipped).
     pub images: Option<images::ImageOptions>,
+    /// Spheres of the objects comparison (0: skipped); see [`objects`].
+    pub objects: usize,
     /// `--quick` (noted in the report).
     pub quick: bool,
     /// The command line, for the report.
@@ -182,6 +185,11 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
     let refit_rows = refit::run(&scenes, opts)?;
     eprintln!("bench: render overhead");
     let overhead_rows = overhead::run(if config.quick { 3 } else { 31 });
+    let objects_rows = if config.objects == 0 {
+        Vec::new()
+    } else {
+        objects::run(config.objects, runs)
+    };
     let image_rows = match &config.images {
         Some(opts) => images::run(opts)?,
         None => Vec::new(),
@@ -217,6 +225,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
         refit: refit_rows,
         images: image_rows,
         overhead: overhead_rows,
+        objects: objects_rows,
         slopes: Vec::new(),
         elapsed_s: 0.0,
     };

@@ -5,6 +5,7 @@
 use crate::error::Error;
 use crate::images::ImageRow;
 use crate::machine::Machine;
+use crate::objects::ObjectsRow;
 use crate::overhead::OverheadRow;
 use crate::plot::{grouped_bars, loglog, Series};
 use crate::refit::RefitRow;
@@ -44,6 +45,8 @@ pub struct BenchResults {
     pub images: Vec<ImageRow>,
     /// The renderer against hand-written casters.
     pub overhead: Vec<OverheadRow>,
+    /// Many one-sphere objects against one object holding them.
+    pub objects: Vec<ObjectsRow>,
     /// Fitted log-log slopes of the plots.
     pub slopes: Vec<SlopeRow>,
     /// Wall time of the whole run, seconds.
@@ -436,6 +439,7 @@ pub fn markdown(r: &BenchResults) -> String {
     s.push_str(&images_section(r));
     refit_section(&mut s, r);
     overhead_section(&mut s, r);
+    objects_section(&mut s, r);
     scale_section(&mut s, r);
     notes_section(&mut s);
     s
@@ -951,6 +955,45 @@ fn refit_section(s: &mut String, r: &BenchResults) {
             x.refitted_mrays,
             x.rays,
             x.differing_hits
+        );
+    }
+    let _ = writeln!(s);
+}
+
+fn objects_section(s: &mut String, r: &BenchResults) {
+    if r.objects.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "## Objects: many one-sphere objects against one object holding them\n\n\
+         The renderer builds an accelerator per object and a BVH over the objects' boxes \
+         (`bench/src/objects.rs`). A grid of spheres on the ground, {size}×{size} pixels, 1 spp, \
+         one point light, single thread: each sphere its own object, against one object holding \
+         every sphere. Render times are medians of {} interleaved pairs; the ratio is the median \
+         of each pair's many ÷ one. Both images must be equal, and equal to brute force (the \
+         one object traced by `AccelKind::Linear`).\n",
+        r.runs,
+        size = crate::objects::SIZE
+    );
+    let _ = writeln!(
+        s,
+        "| spheres | mode | build ms (many) | build ms (one) | render ms (many) | render ms (one) | render ratio | differing bytes | differing bytes vs brute force |\n\
+         |---:|---|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for x in &r.objects {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.2}× | {} | {} |",
+            x.spheres,
+            x.mode,
+            x.many_build_ms,
+            x.one_build_ms,
+            x.many_render_ms,
+            x.one_render_ms,
+            x.render_ratio,
+            x.differing_bytes,
+            x.differing_bytes_brute_force
         );
     }
     let _ = writeln!(s);

@@ -62,7 +62,7 @@ fn run_bench(scenes: &Path, out: &Path, extra: &[&str]) -> std::process::Output 
             "3",
         ])
         .args(["--scale", "500,2000", "--scale-rays", "256"])
-        .args(["--image-spp", "4"])
+        .args(["--image-spp", "4", "--objects", "2000"])
         .arg("--out")
         .arg(out)
         .args(extra)
@@ -209,6 +209,19 @@ fn bench_writes_a_well_formed_report_csv_json_and_plots() {
     let scale = json["scale"].as_array().unwrap();
     assert_eq!(scale.len(), 4);
     assert!(scale[0]["triangles"].as_u64().unwrap() >= 500);
+
+    // Objects: 2,000 one-sphere objects render the bytes of one object holding them, and of
+    // brute force, in both modes.
+    for mode in ["f32", "fixed"] {
+        let contender = format!("raykernel render objects {mode}");
+        for name in ["differing_bytes", "differing_bytes_brute_force"] {
+            assert_eq!(figure(rows, "spheres-2000", "-", &contender, name), 0.0);
+        }
+        for name in ["many_render_ms", "one_render_ms", "render_ratio"] {
+            assert!(figure(rows, "spheres-2000", "-", &contender, name) > 0.0);
+        }
+    }
+    assert!(report.contains("## Objects: many one-sphere objects"));
 
     // Refit: both scenes in both modes after small and large motion; the refitted tree gives
     // the rebuilt tree's hits.
