@@ -15,7 +15,7 @@
 //! Prints a per-architecture summary, writes the table into docs/PLATFORMS.md and the README,
 //! and ends with one `N passed, M failed` line.
 
-use super::{platforms, progress, run, TARGETS};
+use super::{platforms, progress, run_captured, TARGETS};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -93,8 +93,17 @@ fn parse_probe(ok: bool, out: &str) -> ProbeRun {
     r
 }
 
-/// Runs the probe for `target` (`None`: the host), writing hit files into `out/<arch>`.
-fn probe(target: Option<&str>, out: &Path, arch: &str) -> (ProbeRun, PathBuf) {
+/// Runs `c`, then prints `title` and its output together: the groups of [`determinism`] run
+/// side by side, so a command's output must not be split by another's.
+fn run_titled(title: &str, c: Command) -> (bool, String) {
+    let (ok, text) = run_captured(c);
+    print!("\n=== {title} ===\n{text}");
+    (ok, text)
+}
+
+/// Runs the probe for `target` (`None`: the host) under `title`, writing hit files into
+/// `out/<arch>`.
+fn probe(title: &str, target: Option<&str>, out: &Path, arch: &str) -> (ProbeRun, PathBuf) {
     let dir = out.join(arch);
     let _ = std::fs::remove_dir_all(&dir);
     let _ = std::fs::create_dir_all(&dir);
@@ -104,7 +113,7 @@ fn probe(target: Option<&str>, out: &Path, arch: &str) -> (ProbeRun, PathBuf) {
         args.extend(["--target", t]);
     }
     args.extend(["--", &dir_arg]);
-    let (ok, text) = run(cargo_in(&root(), &args));
+    let (ok, text) = run_titled(title, cargo_in(&root(), &args));
     (parse_probe(ok, &text), dir)
 }
 
@@ -160,120 +169,27 @@ fn cargo_test_counts(out: &str) -> (usize, usize) {
     (passed, failed)
 }
 
+/// The three groups have target directories of their own (the workspace's, tests/baremetal's,
+/// tests/qemu's), so they run side by side: the emulators' single-threaded runs overlap the
+/// other groups' builds. Each command's output is printed whole when it ends.
 pub fn determinism() -> bool {
     let out = root().join("target/determinism");
-    let mut rows = Vec::new();
-
-    println!("\n=== x86_64 (native): golden hashes, reference hit files ===");
-    let (x86, reference) = probe(None, &out, "x86_64");
-    let reference_ok = x86.finished && !x86.hit_files.is_empty();
-    rows.push(Row {
-        arch: "x86_64",
-        how: "native (reference)",
-        hashes: x86.golden_ok + x86.golden_failed,
-        hit_files: None,
-        passed: x86.golden_ok + x86.hit_files.len(),
-        failed: x86.golden_failed + usize::from(!reference_ok),
+    let (hosted, riscv, cortex_m) = std::thread::scope(|s| {
+        let riscv = s.spawn(riscv_suite);
+        let cortex_m = s.spawn(cortex_m_suites);
+        let hosted = hosted_probes(&out);
+        (hosted, riscv.join(), cortex_m.join())
     });
-
-    println!("\n=== aarch64 (qemu-aarch64): F4 lanes on NEON, the kernel's golden test ===");
-    let mut unit = (0, 0);
-    for args in [
-        &[
-            "test",
-            "-p",
-            "raykernel",
-            "--target",
-            AARCH64,
-            "--lib",
-            "--",
-            "lanes",
-        ][..],
-        &[
-            "test",
-            "-p",
-            "raykernel",
-            "--target",
-            AARCH64,
-            "--test",
-            "golden",
-        ][..],
-    ] {
-        let (ok, text) = run(cargo_in(&root(), args));
-        let (p, f) = cargo_test_counts(&text);
-        unit.0 += p;
-        unit.1 += f + usize::from(!ok || p == 0);
-    }
-    for (arch, target, how) in [
-        ("aarch64", AARCH64, "qemu-aarch64 (user mode), F4 on NEON"),
-        ("wasm32", WASM32, "Node.js WASI (`node:wasi`)"),
-    ] {
-        if arch == "wasm32" {
-            println!("\n=== wasm32-wasip1 (Node.js WASI) ===");
+    let mut rows = hosted;
+    match (riscv, cortex_m) {
+        (Ok(r), Ok(c)) => {
+            rows.push(r);
+            rows.extend(c);
         }
-        let (r, dir) = probe(Some(target), &out, arch);
-        let (same, differ) = if reference_ok {
-            compare_hits(&r.hit_files, &dir, &reference)
-        } else {
-            (0, r.hit_files.len())
-        };
-        let missing = usize::from(!r.finished || r.hit_files.len() != x86.hit_files.len());
-        let (up, uf) = if arch == "aarch64" { unit } else { (0, 0) };
-        rows.push(Row {
-            arch,
-            how,
-            hashes: r.golden_ok + r.golden_failed,
-            hit_files: Some(same + differ),
-            passed: r.golden_ok + same + up,
-            failed: r.golden_failed + differ + missing + uf,
-        });
-    }
-
-    println!("\n=== riscv32imac (qemu-system-riscv32 virt): tests/baremetal suite ===");
-    let (ok, text) = run(cargo_in(
-        &root().join("tests/baremetal"),
-        &["run", "--release", "--bin", "suite", "--target", RISCV32],
-    ));
-    let count = |suffix: &str| {
-        text.lines()
-            .filter(|l| l.starts_with("test ") && l.contains(suffix))
-            .count()
-    };
-    let golden = text
-        .lines()
-        .filter(|l| l.starts_with("test golden_"))
-        .count();
-    let (p, f) = (count(" ... ok"), count(" ... FAILED"));
-    rows.push(Row {
-        arch: "riscv32imac",
-        how: "qemu-system-riscv32 `virt`, semihosting",
-        hashes: golden,
-        hit_files: None,
-        passed: p,
-        failed: f + usize::from(!ok || p == 0),
-    });
-
-    for (target, core, machine, _) in TARGETS {
-        println!("\n=== {core} ({target}, QEMU {machine}): tests/qemu suite ===");
-        let (ok, text) = run(super::cargo(&["test", "--target", target]));
-        let (last, total, finished) = progress(&text);
-        let ok = ok && finished && total > 0 && last == total;
-        let golden = text
-            .lines()
-            .filter(|l| l.contains("running `golden_") && !l.contains("golden_table"))
-            .count();
-        rows.push(Row {
-            arch: core_arch(core),
-            how: machine_how(core),
-            hashes: golden,
-            hit_files: None,
-            passed: if ok { total } else { last.saturating_sub(1) },
-            failed: if ok {
-                0
-            } else {
-                total.max(1) - last.saturating_sub(1)
-            },
-        });
+        _ => {
+            println!("a determinism group panicked");
+            return false;
+        }
     }
 
     let mut table = String::from(
@@ -304,6 +220,138 @@ pub fn determinism() -> bool {
     let failed = failed + usize::from(failed == 0 && !written);
     println!("{passed} passed, {failed} failed");
     failed == 0
+}
+
+/// x86_64 (the reference), aarch64 and wasm32: golden hashes and hit files.
+fn hosted_probes(out: &Path) -> Vec<Row> {
+    let mut rows = Vec::new();
+
+    let (x86, reference) = probe(
+        "x86_64 (native): golden hashes, reference hit files",
+        None,
+        out,
+        "x86_64",
+    );
+    let reference_ok = x86.finished && !x86.hit_files.is_empty();
+    rows.push(Row {
+        arch: "x86_64",
+        how: "native (reference)",
+        hashes: x86.golden_ok + x86.golden_failed,
+        hit_files: None,
+        passed: x86.golden_ok + x86.hit_files.len(),
+        failed: x86.golden_failed + usize::from(!reference_ok),
+    });
+
+    let mut unit = (0, 0);
+    for args in [
+        &[
+            "test",
+            "-p",
+            "raykernel",
+            "--target",
+            AARCH64,
+            "--lib",
+            "--",
+            "lanes",
+        ][..],
+        &[
+            "test",
+            "-p",
+            "raykernel",
+            "--target",
+            AARCH64,
+            "--test",
+            "golden",
+        ][..],
+    ] {
+        let title = "aarch64 (qemu-aarch64): F4 lanes on NEON, the kernel's golden test";
+        let (ok, text) = run_titled(title, cargo_in(&root(), args));
+        let (p, f) = cargo_test_counts(&text);
+        unit.0 += p;
+        unit.1 += f + usize::from(!ok || p == 0);
+    }
+    for (arch, target, how) in [
+        ("aarch64", AARCH64, "qemu-aarch64 (user mode), F4 on NEON"),
+        ("wasm32", WASM32, "Node.js WASI (`node:wasi`)"),
+    ] {
+        let title = format!("{arch} ({target}): the probe, hit files against x86_64's");
+        let (r, dir) = probe(&title, Some(target), out, arch);
+        let (same, differ) = if reference_ok {
+            compare_hits(&r.hit_files, &dir, &reference)
+        } else {
+            (0, r.hit_files.len())
+        };
+        let missing = usize::from(!r.finished || r.hit_files.len() != x86.hit_files.len());
+        let (up, uf) = if arch == "aarch64" { unit } else { (0, 0) };
+        rows.push(Row {
+            arch,
+            how,
+            hashes: r.golden_ok + r.golden_failed,
+            hit_files: Some(same + differ),
+            passed: r.golden_ok + same + up,
+            failed: r.golden_failed + differ + missing + uf,
+        });
+    }
+
+    rows
+}
+
+/// riscv32imac: the bare-metal suite.
+fn riscv_suite() -> Row {
+    let (ok, text) = run_titled(
+        "riscv32imac (qemu-system-riscv32 virt): tests/baremetal suite",
+        cargo_in(
+            &root().join("tests/baremetal"),
+            &["run", "--release", "--bin", "suite", "--target", RISCV32],
+        ),
+    );
+    let count = |suffix: &str| {
+        text.lines()
+            .filter(|l| l.starts_with("test ") && l.contains(suffix))
+            .count()
+    };
+    let golden = text
+        .lines()
+        .filter(|l| l.starts_with("test golden_"))
+        .count();
+    let (p, f) = (count(" ... ok"), count(" ... FAILED"));
+    Row {
+        arch: "riscv32imac",
+        how: "qemu-system-riscv32 `virt`, semihosting",
+        hashes: golden,
+        hit_files: None,
+        passed: p,
+        failed: f + usize::from(!ok || p == 0),
+    }
+}
+
+/// The Cortex-M cores: the defmt-test suites, one core after the other (one target dir).
+fn cortex_m_suites() -> Vec<Row> {
+    let mut rows = Vec::new();
+    for (target, core, machine, _) in TARGETS {
+        let title = format!("{core} ({target}, QEMU {machine}): tests/qemu suite");
+        let (ok, text) = run_titled(&title, super::cargo(&["test", "--target", target]));
+        let (last, total, finished) = progress(&text);
+        let ok = ok && finished && total > 0 && last == total;
+        let golden = text
+            .lines()
+            .filter(|l| l.contains("running `golden_") && !l.contains("golden_table"))
+            .count();
+        rows.push(Row {
+            arch: core_arch(core),
+            how: machine_how(core),
+            hashes: golden,
+            hit_files: None,
+            passed: if ok { total } else { last.saturating_sub(1) },
+            failed: if ok {
+                0
+            } else {
+                total.max(1) - last.saturating_sub(1)
+            },
+        });
+    }
+
+    rows
 }
 
 fn core_arch(core: &str) -> &'static str {

@@ -135,7 +135,14 @@ fn cargo(args: &[&str]) -> Command {
 }
 
 /// Runs `c`, echoing its output; returns (success, stdout + stderr).
-fn run(mut c: Command) -> (bool, String) {
+fn run(c: Command) -> (bool, String) {
+    let (ok, text) = run_captured(c);
+    print!("{text}");
+    (ok, text)
+}
+
+/// Runs `c` and returns whether it succeeded and its stderr then stdout, printing nothing.
+fn run_captured(mut c: Command) -> (bool, String) {
     match c.stdout(Stdio::piped()).stderr(Stdio::piped()).output() {
         Ok(out) => {
             let text = format!(
@@ -143,13 +150,9 @@ fn run(mut c: Command) -> (bool, String) {
                 String::from_utf8_lossy(&out.stderr),
                 String::from_utf8_lossy(&out.stdout)
             );
-            print!("{text}");
             (out.status.success(), text)
         }
-        Err(e) => {
-            println!("cannot run {c:?}: {e}");
-            (false, String::new())
-        }
+        Err(e) => (false, format!("cannot run {c:?}: {e}\n")),
     }
 }
 
