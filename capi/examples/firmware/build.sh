@@ -19,6 +19,13 @@ arm-none-eabi-gcc -mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 -O2
     "$root/target/thumbv7em-none-eabihf/release/libraykernel_c.a" -lgcc \
     -o "$out/firmware.elf"
 arm-none-eabi-size "$out/firmware.elf"
+# No panic path may be linked (--gc-sections keeps only what is reachable): the kernel and the
+# C glue answer every input with a status, and a panic in firmware would hang the device.
+if arm-none-eabi-nm -C "$out/firmware.elf" | grep -E ' (core::panicking::|rust_begin_unwind)'; then
+    echo "the firmware links a panic path (above)" >&2
+    rm -rf "$out"
+    exit 1
+fi
 status=0
 output=$(timeout 120 qemu-system-arm -machine mps2-an386 -cpu cortex-m4 -nographic -monitor none \
     -semihosting-config enable=on,target=native -kernel "$out/firmware.elf" 2>&1) || status=$?

@@ -91,13 +91,20 @@ pub(crate) fn dir_in_mode<S: Scalar>(d: [f32; 3]) -> S::Vec3 {
     S::array_to_vec(d.map(|x| S::from_f32_saturating(x * 1024.0)))
 }
 
+/// The axis (0, 1 or 2) of `n`'s largest magnitude, first on ties.
+///
+/// Always inlined, and clamped: callers index three-element arrays with it, and the bound
+/// must be visible to the optimiser in every build (out of line, a C library's build kept a
+/// bounds check, a panic path, at each use).
+#[inline(always)]
 fn dominant(n: [f32; 3]) -> usize {
     let a = n.map(libm::fabsf);
-    if a[0] >= a[1] && a[0] >= a[2] {
+    let axis = if a[0] >= a[1] && a[0] >= a[2] {
         0
     } else if a[1] >= a[2] {
         1
     } else {
         2
-    }
+    };
+    axis.min(2)
 }
