@@ -302,6 +302,8 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
 
     /// The point a hit lies on: world position, unit geometric normal (not yet facing the
     /// ray), and what [`SurfacePoint::spawn_origin`] needs to leave it. `None` for lights.
+    /// Inlined on hosted targets into both integrators (see `lighting::visible`).
+    #[cfg_attr(not(target_os = "none"), inline(always))]
     pub(crate) fn surface_point(
         &self,
         ray: &Ray<S>,

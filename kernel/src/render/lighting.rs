@@ -60,7 +60,12 @@ pub(super) fn phong_density(c: f32, exponent: f32) -> f32 {
 /// per area light, each tested by a shadow ray; `w` is the [`Lobe`]'s weight. With `mis`, area
 /// lights' samples carry the power heuristic's weight against BSDF sampling (point lights,
 /// which BSDF sampling cannot reach, weight 1); without it every sample weighs 1.
+///
+/// Always inlined on hosted targets (as the integrators' loops are): each call site then has
+/// its lobe and `mis` as constants, so the direct integrator's diffuse-only sum carries no
+/// branch for what it does not use. Bare-metal targets keep one copy, for flash.
 #[allow(clippy::too_many_arguments)]
+#[cfg_attr(not(target_os = "none"), inline(always))]
 pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
     r: &Renderer<'_, S, F>,
     sp: &SurfacePoint<'_, S>,
@@ -209,7 +214,10 @@ pub(super) fn light_pdf<S: SpawnScalar, F: AccelFamily<S>>(
     }
 }
 
-/// True if nothing blocks the segment from the surface point to `target`.
+/// True if nothing blocks the segment from the surface point to `target`. Inlined on hosted
+/// targets as [`light_sum`] is (two integrators call it; left alone, the optimiser keeps it
+/// out of line and the direct integrator pays the calls).
+#[cfg_attr(not(target_os = "none"), inline(always))]
 fn visible<S: SpawnScalar, F: AccelFamily<S>>(
     r: &Renderer<'_, S, F>,
     sp: &SurfacePoint<'_, S>,

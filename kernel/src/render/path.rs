@@ -43,7 +43,10 @@ enum Previous {
 
 /// Radiance of one pixel sample under the path integrator with paths of at most `max_length`
 /// segments.
-#[cfg_attr(not(target_os = "none"), inline(always))] // see `integrator::sample_radiance`
+///
+/// Never inlined: a path costs many rays, so the call is nothing to it, while inlined into the
+/// pixel loop it would change how the optimiser treats the direct integrator's loop there.
+#[inline(never)]
 pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
     r: &Renderer<'_, S, F>,
     x: u32,
