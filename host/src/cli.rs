@@ -55,9 +55,9 @@ pub enum Command {
     /// --scene and --rays, also check each differing ray passes within quantization error of an
     /// edge of a reported triangle.
     CompareHits(CompareArgs),
-    /// Render a scene with the distribution ray tracer: a built-in scene (default `cornell`),
-    /// a scene file (.json, see docs/SCENE_FORMAT.md) or an OBJ mesh; PNG out, optionally
-    /// linear PFM; parallel over tiles.
+    /// Render a scene (distribution ray tracer, or path tracer with `--integrator path`): a
+    /// built-in scene (default `cornell`), a scene file (.json, see docs/SCENE_FORMAT.md) or an
+    /// OBJ mesh; PNG out, optionally linear PFM; parallel over tiles.
     Render(RenderArgs),
     /// Render scenes every way (kernel single-threaded, host tiles at several thread counts
     /// and tile sizes, every accelerator) and check all are byte-identical.
