@@ -133,7 +133,7 @@ pub fn figures(r: &BenchResults) -> Vec<Figure> {
         );
     }
     for x in &r.refit {
-        let contender = format!("raykernel refit {}", x.mode);
+        let contender = format!("raykernel refit {} {}%", x.mode, x.amplitude * 100.0);
         for (figure, value) in [
             ("rebuild_ms", x.rebuild_ms),
             ("refit_bvh_ms", x.refit_bvh_ms),

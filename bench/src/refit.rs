@@ -41,10 +41,12 @@ pub struct RefitRow {
     pub differing_hits: usize,
 }
 
-/// The displacement's amplitude, a fraction of the scene box's diagonal.
-pub const AMPLITUDE: f64 = 0.01;
+/// The displacements' amplitudes, fractions of the scene box's diagonal: a small motion (an
+/// animation step) and a large one (a deformation far from the pose the tree was built for).
+pub const AMPLITUDES: [f64; 2] = [0.01, 0.1];
 
-/// Refit and rebuild on every scene in both modes (fixed only where the scene fits).
+/// Refit and rebuild on every scene, for each of [`AMPLITUDES`], in both modes (fixed only
+/// where the moved scene fits).
 ///
 /// # Errors
 /// A scene the kernel refuses to build, or a refit refusing the moved mesh.
@@ -52,18 +54,21 @@ pub fn run(scenes: &[BenchScene], opts: RunOptions) -> Result<Vec<RefitRow>, Err
     let mut rows = Vec::new();
     for scene in scenes {
         eprintln!("bench: refit {}", scene.name);
-        let moved = moved_triangles(scene);
         let rays = scene
             .ray_sets
             .iter()
             .find(|s| s.kind == RayKind::Primary)
             .map_or(&[][..], |s| &s.records[..]);
         let before32 = scene.mesh.kernel_triangles::<f32>(&scene.path)?;
-        let after32 = to_kernel::<f32>(&moved).ok_or_else(|| bad_motion(scene))?;
-        rows.push(measure(scene, "f32", &before32, &after32, rays, opts)?);
-        let fixed = scene.mesh.kernel_triangles::<I16F16>(&scene.path).ok();
-        if let (Some(before), Some(after)) = (fixed, to_kernel::<I16F16>(&moved)) {
-            rows.push(measure(scene, "fixed", &before, &after, rays, opts)?);
+        let before_fixed = scene.mesh.kernel_triangles::<I16F16>(&scene.path).ok();
+        for amplitude in AMPLITUDES {
+            let moved = moved_triangles(scene, amplitude);
+            let after32 = to_kernel::<f32>(&moved).ok_or_else(|| bad_motion(scene))?;
+            let motion = (amplitude, rays);
+            rows.push(measure(scene, "f32", &before32, &after32, motion, opts)?);
+            if let (Some(before), Some(after)) = (&before_fixed, to_kernel::<I16F16>(&moved)) {
+                rows.push(measure(scene, "fixed", before, &after, motion, opts)?);
+            }
         }
     }
     Ok(rows)
@@ -76,13 +81,13 @@ fn bad_motion(scene: &BenchScene) -> Error {
     ))
 }
 
-/// Each vertex `p` moved by `a·(sin(k·p.y), sin(k·p.z), sin(k·p.x))`, `a` = [`AMPLITUDE`] of the
+/// Each vertex `p` moved by `a·(sin(k·p.y), sin(k·p.z), sin(k·p.x))`, `a` = `amplitude` times the
 /// box diagonal and `k` four periods across it: neighbouring triangles move together, as in
 /// an animated mesh, so the old grouping stays reasonable.
-fn moved_triangles(scene: &BenchScene) -> Vec<[[f32; 3]; 3]> {
+fn moved_triangles(scene: &BenchScene, amplitude: f64) -> Vec<[[f32; 3]; 3]> {
     let (lo, hi) = crate::workload::referenced_bounds(&scene.mesh);
     let diagonal = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt();
-    let a = AMPLITUDE * diagonal;
+    let a = amplitude * diagonal;
     let k = if diagonal > 0.0 {
         8.0 * std::f64::consts::PI / diagonal
     } else {
@@ -111,7 +116,7 @@ fn measure<S: Scalar>(
     mode: &'static str,
     before: &[Triangle<S>],
     after: &[Triangle<S>],
-    rays: &[host::rayfile::RayRecord],
+    (amplitude, rays): (f64, &[host::rayfile::RayRecord]),
     opts: RunOptions,
 ) -> Result<RefitRow, Error> {
     let build_error = |source| host::Error::Build {
@@ -175,7 +180,7 @@ fn measure<S: Scalar>(
         scene: scene.name.clone(),
         triangles: n,
         mode,
-        amplitude: AMPLITUDE,
+        amplitude,
         rebuild_ms: median(&rebuild_ms),
         refit_bvh_ms: median(&refit_bvh_ms),
         refit_bvh4_ms: median(&refit_bvh4_ms),

@@ -919,27 +919,31 @@ fn refit_section(s: &mut String, r: &BenchResults) {
     let _ = writeln!(
         s,
         "## Refit: new boxes for a moved mesh, against rebuilding\n\n\
-         Every vertex moves by a smooth field of amplitude {:.0}% of the scene box's diagonal \
-         (`bench/src/refit.rs`). Rebuild: the SAH BVH and its 4-wide collapse over the moved \
-         mesh; refit: `Bvh::refit` and `Bvh4::refit` of the trees built before the motion \
-         (same topology, new boxes). Then the primary rays through each 4-wide tree \
-         (pre-built rays): the refitted tree's loss per ray, and its hits, which must equal \
-         the rebuilt tree's. Medians of {} runs; single thread.\n",
-        r.refit.first().map_or(0.0, |x| x.amplitude * 100.0),
+         Every vertex moves by a smooth field (`bench/src/refit.rs`) whose amplitude, the \
+         `motion` column, is a fraction of the scene box's diagonal: {:.0}% as in an animation \
+         step, {:.0}% for a deformation far from the pose the tree was built for. Rebuild: the \
+         SAH BVH and its 4-wide collapse over the moved mesh; refit: `Bvh::refit` and \
+         `Bvh4::refit` of the trees built before the motion (same topology, new boxes). Then \
+         the primary rays through each 4-wide tree (pre-built rays): the refitted tree's loss \
+         per ray, and its hits, which must equal the rebuilt tree's. Medians of {} runs; \
+         single thread.\n",
+        crate::refit::AMPLITUDES[0] * 100.0,
+        crate::refit::AMPLITUDES[1] * 100.0,
         r.runs
     );
     let _ = writeln!(
         s,
-        "| scene | triangles | mode | rebuild ms | refit BVH ms | refit BVH4 ms | rebuilt Mrays/s | refitted Mrays/s | rays | differing hits |\n\
-         |---|---:|---|---:|---:|---:|---:|---:|---:|---:|"
+        "| scene | triangles | mode | motion | rebuild ms | refit BVH ms | refit BVH4 ms | rebuilt Mrays/s | refitted Mrays/s | rays | differing hits |\n\
+         |---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for x in &r.refit {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {} |",
+            "| {} | {} | {} | {:.0}% | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {} |",
             x.scene,
             x.triangles,
             x.mode,
+            x.amplitude * 100.0,
             x.rebuild_ms,
             x.refit_bvh_ms,
             x.refit_bvh4_ms,

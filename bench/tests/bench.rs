@@ -210,10 +210,11 @@ fn bench_writes_a_well_formed_report_csv_json_and_plots() {
     assert_eq!(scale.len(), 4);
     assert!(scale[0]["triangles"].as_u64().unwrap() >= 500);
 
-    // Refit: both scenes in both modes; the refitted tree gives the rebuilt tree's hits.
+    // Refit: both scenes in both modes after small and large motion; the refitted tree gives
+    // the rebuilt tree's hits.
     for scene in ["ball", "fine"] {
-        for mode in ["f32", "fixed"] {
-            let contender = format!("raykernel refit {mode}");
+        for contender in ["f32 1%", "fixed 1%", "f32 10%", "fixed 10%"] {
+            let contender = format!("raykernel refit {contender}");
             assert_eq!(
                 figure(rows, scene, "primary", &contender, "differing_hits"),
                 0.0

@@ -38,6 +38,122 @@
 #define RK_ACCEL_WORDS 24
 
 /**
+ * `RkObject::shape`: a triangle mesh, nine floats per triangle (x y z of three vertices).
+ */
+#define RK_SHAPE_TRIANGLES 1
+
+/**
+ * `RkObject::shape`: spheres, four floats each (centre x y z, radius).
+ */
+#define RK_SHAPE_SPHERES 2
+
+/**
+ * `RkMaterial::kind`: Lambertian, `color` is the albedo (each channel in `[0, 1]`).
+ */
+#define RK_MATERIAL_DIFFUSE 1
+
+/**
+ * `RkMaterial::kind`: perfect mirror, `color` is the reflectance.
+ */
+#define RK_MATERIAL_MIRROR 2
+
+/**
+ * `RkMaterial::kind`: glossy (Phong lobe of `exponent >= 1`), `color` is the reflectance.
+ */
+#define RK_MATERIAL_GLOSSY 3
+
+/**
+ * `RkMaterial::kind`: emits `color` (radiance, `>= 0`) and reflects nothing.
+ */
+#define RK_MATERIAL_EMISSIVE 4
+
+/**
+ * `RkLight::kind`: a point at `position` of radiant intensity `color`.
+ */
+#define RK_LIGHT_POINT 1
+
+/**
+ * `RkLight::kind`: the parallelogram `position + a·edge_u + b·edge_v` (`a, b` in `[0, 1]`)
+ * emitting radiance `color` towards `edge_u × edge_v`.
+ */
+#define RK_LIGHT_RECT 2
+
+/**
+ * `RkLight::kind`: a sphere at `position` of `radius` emitting radiance `color`.
+ */
+#define RK_LIGHT_SPHERE 3
+
+/**
+ * Most lights a scene may have.
+ */
+#define RK_MAX_LIGHTS 8
+
+/**
+ * `RkRenderSettings::sampler`: a hash per random value.
+ */
+#define RK_SAMPLER_INDEPENDENT 1
+
+/**
+ * `RkRenderSettings::sampler`: stratified (jittered) samples (the default).
+ */
+#define RK_SAMPLER_STRATIFIED 2
+
+/**
+ * `RkRenderSettings::sampler`: Owen-scrambled Sobol points.
+ */
+#define RK_SAMPLER_SOBOL 3
+
+/**
+ * `RkRenderSettings::filter`: uniform over the pixel (the default).
+ */
+#define RK_FILTER_BOX 1
+
+/**
+ * `RkRenderSettings::filter`: triangle filter of radius one pixel.
+ */
+#define RK_FILTER_TENT 2
+
+/**
+ * `RkSceneError::item`: a field of the `RkScene` itself (mode, kind, an array pointer).
+ */
+#define RK_ITEM_SCENE 0
+
+/**
+ * `RkSceneError::item`: `objects[index]`.
+ */
+#define RK_ITEM_OBJECT 1
+
+/**
+ * `RkSceneError::item`: `materials[index]`.
+ */
+#define RK_ITEM_MATERIAL 2
+
+/**
+ * `RkSceneError::item`: `lights[index]`.
+ */
+#define RK_ITEM_LIGHT 3
+
+/**
+ * `RkSceneError::item`: the camera.
+ */
+#define RK_ITEM_CAMERA 4
+
+/**
+ * `RkSceneError::item`: the settings or the background.
+ */
+#define RK_ITEM_SETTINGS 5
+
+/**
+ * Bytes of `RkSceneError::field`, its NUL included.
+ */
+#define RK_FIELD_LEN 32
+
+/**
+ * 64-bit words of an [`RkRenderer`].
+ */
+#define RK_RENDERER_WORDS 4
+
+/**
  * What a call did. `RK_STATUS_OK` is 0; every other value is an error that changed nothing the
  * caller can observe, except as documented per function.
  */
@@ -51,11 +167,12 @@ typedef enum RkStatus {
    */
   RK_STATUS_ERR_NULL = 1,
   /**
-   * An unknown mode, kind or leaf size.
+   * An unknown mode, kind or leaf size (or, in a scene, shape, material or light kind,
+   * sampler or filter).
    */
   RK_STATUS_ERR_BAD_ARGUMENT = 2,
   /**
-   * The memory passed is smaller than `rk_build_bytes` says.
+   * The memory passed is smaller than `rk_build_bytes` (or `rk_render_bytes`) says.
    */
   RK_STATUS_ERR_MEMORY_TOO_SMALL = 3,
   /**
@@ -68,7 +185,8 @@ typedef enum RkStatus {
    */
   RK_STATUS_ERR_BAD_FILE = 5,
   /**
-   * Baked bytes do not start at a multiple of `rk_baked_align()` bytes.
+   * Baked bytes do not start at a multiple of `rk_baked_align()` bytes, or a scene array is
+   * not aligned for its type.
    */
   RK_STATUS_ERR_MISALIGNED = 6,
   /**
@@ -84,13 +202,62 @@ typedef enum RkStatus {
    */
   RK_STATUS_ERR_NOT_REFITTABLE = 9,
   /**
-   * The `RkAccel` was not filled by `rk_build` or `rk_load_baked`.
+   * The `RkAccel` was not filled by `rk_build` or `rk_load_baked` (or the `RkRenderer` by
+   * `rk_renderer_init`).
    */
   RK_STATUS_ERR_NOT_INITIALISED = 10,
   /**
-   * Too many triangles for the kernel.
+   * Too many triangles (or objects) for the kernel, or sizes beyond the address space.
    */
   RK_STATUS_ERR_TOO_LARGE = 11,
+  /**
+   * A sphere's centre is non-finite or outside the mode's range, or its radius is negative.
+   */
+  RK_STATUS_ERR_BAD_SPHERE = 12,
+  /**
+   * A scene value is NaN or infinite (`RkSceneError` says which).
+   */
+  RK_STATUS_ERR_NON_FINITE = 13,
+  /**
+   * A scene value is negative.
+   */
+  RK_STATUS_ERR_NEGATIVE = 14,
+  /**
+   * A reflectance is above 1.
+   */
+  RK_STATUS_ERR_ABOVE_ONE = 15,
+  /**
+   * A scene value (size, spp, radius, distance) must be greater than zero.
+   */
+  RK_STATUS_ERR_NOT_POSITIVE = 16,
+  /**
+   * A scene value is outside its range (`RkSceneError::min`, `max`).
+   */
+  RK_STATUS_ERR_OUT_OF_RANGE = 17,
+  /**
+   * A rectangle light's edges span no area.
+   */
+  RK_STATUS_ERR_ZERO_AREA = 18,
+  /**
+   * A zero-length direction, or the camera's up parallel to its view.
+   */
+  RK_STATUS_ERR_DEGENERATE = 19,
+  /**
+   * An object's material index is past the materials.
+   */
+  RK_STATUS_ERR_BAD_INDEX = 20,
+  /**
+   * More lights than `RK_MAX_LIGHTS`.
+   */
+  RK_STATUS_ERR_TOO_MANY = 21,
+  /**
+   * A tile reaches outside the image.
+   */
+  RK_STATUS_ERR_BAD_TILE = 22,
+  /**
+   * The output buffer is smaller than 3 bytes per pixel of the tile.
+   */
+  RK_STATUS_ERR_BUFFER_TOO_SMALL = 23,
 } RkStatus;
 
 /**
@@ -149,6 +316,238 @@ typedef struct RkHit {
    */
   float v;
 } RkHit;
+
+/**
+ * Image and sampling settings. Start from `rk_render_settings_default()` and set what you
+ * need: fields added later then keep their defaults.
+ */
+typedef struct RkRenderSettings {
+  /**
+   * Image width, pixels (`>= 1`).
+   */
+  uint32_t width;
+  /**
+   * Image height, pixels (`>= 1`).
+   */
+  uint32_t height;
+  /**
+   * Samples per pixel (`>= 1`); 1 samples each pixel centre.
+   */
+  uint32_t spp;
+  /**
+   * Most reflection bounces after the camera ray.
+   */
+  uint32_t max_depth;
+  /**
+   * `RK_SAMPLER_*`.
+   */
+  uint32_t sampler;
+  /**
+   * `RK_FILTER_*`.
+   */
+  uint32_t filter;
+  /**
+   * Seed of every random value: equal seeds give equal images, bit for bit.
+   */
+  uint32_t seed;
+} RkRenderSettings;
+
+/**
+ * One object: a triangle mesh or a set of spheres with one material, static or moving
+ * linearly over the shutter interval.
+ */
+typedef struct RkObject {
+  /**
+   * `RK_SHAPE_TRIANGLES` or `RK_SHAPE_SPHERES`.
+   */
+  uint32_t shape;
+  /**
+   * Index into `RkScene::materials`.
+   */
+  uint32_t material;
+  /**
+   * Triangles or spheres in `data`.
+   */
+  uint32_t count;
+  /**
+   * Nine floats per triangle or four per sphere (see `shape`), at shutter open.
+   */
+  const float *data;
+  /**
+   * Displacement from shutter open to shutter close (zero: static).
+   */
+  float motion[3];
+} RkObject;
+
+/**
+ * A material, tagged by `kind` (`RK_MATERIAL_*`).
+ */
+typedef struct RkMaterial {
+  /**
+   * `RK_MATERIAL_DIFFUSE`, `_MIRROR`, `_GLOSSY` or `_EMISSIVE`.
+   */
+  uint32_t kind;
+  /**
+   * Albedo, reflectance or emitted radiance (linear RGB), as `kind` says.
+   */
+  float color[3];
+  /**
+   * Glossy lobe exponent (`>= 1`); ignored by the other kinds.
+   */
+  float exponent;
+} RkMaterial;
+
+/**
+ * A light, tagged by `kind` (`RK_LIGHT_*`); the fields a kind does not name are ignored.
+ */
+typedef struct RkLight {
+  /**
+   * `RK_LIGHT_POINT`, `_RECT` or `_SPHERE`.
+   */
+  uint32_t kind;
+  /**
+   * Point position, rectangle corner or sphere centre.
+   */
+  float position[3];
+  /**
+   * Rectangle: first edge.
+   */
+  float edge_u[3];
+  /**
+   * Rectangle: second edge.
+   */
+  float edge_v[3];
+  /**
+   * Sphere: radius (`> 0`).
+   */
+  float radius;
+  /**
+   * Point: radiant intensity; rectangle and sphere: emitted radiance (linear RGB, `>= 0`).
+   */
+  float color[3];
+} RkLight;
+
+/**
+ * A thin-lens camera; `aperture_radius == 0` is a pinhole.
+ */
+typedef struct RkCamera {
+  /**
+   * Eye (lens centre).
+   */
+  float eye[3];
+  /**
+   * A point on the optical axis.
+   */
+  float look_at[3];
+  /**
+   * Up hint (not parallel to the view direction).
+   */
+  float up[3];
+  /**
+   * Full vertical field of view, degrees, in `(0, 180)`.
+   */
+  float vfov_deg;
+  /**
+   * Lens radius, `>= 0`.
+   */
+  float aperture_radius;
+  /**
+   * Distance to the plane in focus, `> 0` (ignored for a pinhole).
+   */
+  float focus_distance;
+} RkCamera;
+
+/**
+ * A whole scene, borrowed for the duration of `rk_render_bytes` and `rk_renderer_init`.
+ * Arrays may be null when their count is 0.
+ */
+typedef struct RkScene {
+  /**
+   * `RK_MODE_F32` or `RK_MODE_FIXED`: the number mode of the geometry.
+   */
+  uint32_t mode;
+  /**
+   * Each object's accelerator: `RK_KIND_BVH4` (or 0, the default) or `RK_KIND_BVH`.
+   * Every kind gives the same image.
+   */
+  uint32_t kind;
+  /**
+   * Objects, in the order that breaks ties between equal hits (lowest first).
+   */
+  const struct RkObject *objects;
+  /**
+   * Entries of `objects`.
+   */
+  uint32_t object_count;
+  /**
+   * Materials, indexed by `RkObject::material`.
+   */
+  const struct RkMaterial *materials;
+  /**
+   * Entries of `materials`.
+   */
+  uint32_t material_count;
+  /**
+   * Lights (at most `RK_MAX_LIGHTS`).
+   */
+  const struct RkLight *lights;
+  /**
+   * Entries of `lights`.
+   */
+  uint32_t light_count;
+  /**
+   * Camera.
+   */
+  struct RkCamera camera;
+  /**
+   * Radiance of rays that leave the scene (linear RGB, `>= 0`).
+   */
+  float background[3];
+  /**
+   * Image and sampling settings.
+   */
+  struct RkRenderSettings settings;
+} RkScene;
+
+/**
+ * A renderer ready for tiles, filled by `rk_renderer_init`. Opaque; copy it freely (copies
+ * share the caller's memory).
+ */
+typedef struct RkRenderer {
+  /**
+   * Private.
+   */
+  uint64_t opaque[RK_RENDERER_WORDS];
+} RkRenderer;
+
+/**
+ * Which value `rk_renderer_init` rejected: `item` (`RK_ITEM_*`), its `index` in its list (0
+ * for the scene, camera and settings), the name of the C field holding it (NUL-terminated;
+ * `memory` when the memory is too small), and for `RK_STATUS_ERR_OUT_OF_RANGE` the accepted
+ * range.
+ */
+typedef struct RkSceneError {
+  /**
+   * `RK_ITEM_*`.
+   */
+  uint32_t item;
+  /**
+   * Index within the item's list.
+   */
+  uint32_t index;
+  /**
+   * The field's name.
+   */
+  char field[RK_FIELD_LEN];
+  /**
+   * Lowest accepted value (`RK_STATUS_ERR_OUT_OF_RANGE` only, else 0).
+   */
+  float min;
+  /**
+   * Highest accepted value (`RK_STATUS_ERR_OUT_OF_RANGE` only, else 0).
+   */
+  float max;
+} RkSceneError;
 
 #ifdef __cplusplus
 extern "C" {
@@ -210,6 +609,46 @@ enum RkStatus rk_intersect(const struct RkAccel *accel, const struct RkRay *ray,
  * Whether anything is hit within the ray's interval (shadow rays), into `occluded`.
  */
 enum RkStatus rk_occluded(const struct RkAccel *accel, const struct RkRay *ray, bool *occluded);
+
+/**
+ * The kernel's default settings (its `Settings::default()`), to start from.
+ */
+struct RkRenderSettings rk_render_settings_default(void);
+
+/**
+ * Bytes of memory `rk_renderer_init` needs for `scene` (any alignment: 127 bytes of it are
+ * slack for aligning), or 0 if `scene` is null or unusable before any value is checked
+ * (unknown mode, kind or shape, a mode and kind the crate's features leave out, a null array,
+ * sizes beyond the address space).
+ */
+size_t rk_render_bytes(const struct RkScene *scene);
+
+/**
+ * Checks `scene` and builds a renderer for it into `memory` (`memory_bytes >=
+ * rk_render_bytes(scene)`), filling `out`. On an error, `*error` (when not null) names the
+ * value at fault, `out` is left uninitialised (`RK_STATUS_ERR_NOT_INITIALISED` if used) and
+ * `memory` holds nothing of use. `memory` must stay valid, unmoved and unmodified while
+ * `out` (or a copy) is used.
+ */
+enum RkStatus rk_renderer_init(const struct RkScene *scene,
+                               void *memory,
+                               size_t memory_bytes,
+                               struct RkRenderer *out,
+                               struct RkSceneError *error);
+
+/**
+ * Renders the tile of columns `x..x + width` and rows `y..y + height` as 8-bit sRGB into
+ * `out` (3 bytes per pixel, row-major within the tile, `out_len >= 3·width·height`): the same
+ * bytes as rendering the whole image and cutting the tile out. Tiles may be rendered in any
+ * order and at the same time from several threads or cores (the renderer is only read).
+ */
+enum RkStatus rk_render_tile(const struct RkRenderer *renderer,
+                             uint32_t x,
+                             uint32_t y,
+                             uint32_t width,
+                             uint32_t height,
+                             uint8_t *out,
+                             size_t out_len);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -1,8 +1,9 @@
 //! C interface to raykernel: size the memory, build into it (or load baked bytes in place),
 //! refit after motion, and query closest and any hit, in `f32` or fixed point, on a binary or
-//! 4-wide BVH. No allocation and no global state: every structure lives in memory the caller
-//! passes, and an [`RkAccel`] is a plain value the caller keeps (it holds pointers into that
-//! memory, which must outlive it and not move).
+//! 4-wide BVH; and render a scene tile by tile (`render.rs`). No allocation and no global state:
+//! every structure lives in memory the caller passes, and an [`RkAccel`] or [`RkRenderer`] is a
+//! plain value the caller keeps (it holds pointers into that memory, which must outlive it and
+//! not move).
 //!
 //! The header `include/raykernel.h` is generated from this file by cbindgen (the test
 //! `header.rs` checks the committed one matches). Every function checks its pointers for
@@ -10,6 +11,10 @@
 #![cfg_attr(target_os = "none", no_std)]
 #![deny(unsafe_op_in_unsafe_fn)]
 #![allow(clippy::missing_safety_doc)] // every `# Safety` is the same contract, stated once below
+
+mod render;
+
+pub use render::*;
 
 use core::ffi::{c_char, c_void};
 use core::mem::{align_of, size_of};
@@ -29,16 +34,18 @@ pub enum RkStatus {
     Ok = 0,
     /// A required pointer is null.
     ErrNull = 1,
-    /// An unknown mode, kind or leaf size.
+    /// An unknown mode, kind or leaf size (or, in a scene, shape, material or light kind,
+    /// sampler or filter).
     ErrBadArgument = 2,
-    /// The memory passed is smaller than `rk_build_bytes` says.
+    /// The memory passed is smaller than `rk_build_bytes` (or `rk_render_bytes`) says.
     ErrMemoryTooSmall = 3,
     /// A vertex is non-finite or outside the mode's coordinate range.
     ErrBadTriangle = 4,
     /// Baked bytes: not a baked file, unknown version, a bad header field, wrong length or
     /// checksum.
     ErrBadFile = 5,
-    /// Baked bytes do not start at a multiple of `rk_baked_align()` bytes.
+    /// Baked bytes do not start at a multiple of `rk_baked_align()` bytes, or a scene array is
+    /// not aligned for its type.
     ErrMisaligned = 6,
     /// Baked bytes: the tree or its triangles are invalid.
     ErrBadTree = 7,
@@ -46,10 +53,35 @@ pub enum RkStatus {
     ErrBadRay = 8,
     /// `rk_refit` on a baked (read-only) structure, or with another triangle count.
     ErrNotRefittable = 9,
-    /// The `RkAccel` was not filled by `rk_build` or `rk_load_baked`.
+    /// The `RkAccel` was not filled by `rk_build` or `rk_load_baked` (or the `RkRenderer` by
+    /// `rk_renderer_init`).
     ErrNotInitialised = 10,
-    /// Too many triangles for the kernel.
+    /// Too many triangles (or objects) for the kernel, or sizes beyond the address space.
     ErrTooLarge = 11,
+    /// A sphere's centre is non-finite or outside the mode's range, or its radius is negative.
+    ErrBadSphere = 12,
+    /// A scene value is NaN or infinite (`RkSceneError` says which).
+    ErrNonFinite = 13,
+    /// A scene value is negative.
+    ErrNegative = 14,
+    /// A reflectance is above 1.
+    ErrAboveOne = 15,
+    /// A scene value (size, spp, radius, distance) must be greater than zero.
+    ErrNotPositive = 16,
+    /// A scene value is outside its range (`RkSceneError::min`, `max`).
+    ErrOutOfRange = 17,
+    /// A rectangle light's edges span no area.
+    ErrZeroArea = 18,
+    /// A zero-length direction, or the camera's up parallel to its view.
+    ErrDegenerate = 19,
+    /// An object's material index is past the materials.
+    ErrBadIndex = 20,
+    /// More lights than `RK_MAX_LIGHTS`.
+    ErrTooMany = 21,
+    /// A tile reaches outside the image.
+    ErrBadTile = 22,
+    /// The output buffer is smaller than 3 bytes per pixel of the tile.
+    ErrBufferTooSmall = 23,
 }
 
 /// Number mode: `f32`.
@@ -174,7 +206,7 @@ pub extern "C" fn rk_status_name(status: i32) -> *const c_char {
     let name: &'static [u8] = match status {
         0 => b"ok\0",
         1 => b"null pointer\0",
-        2 => b"bad argument (mode, kind or leaf size)\0",
+        2 => b"bad argument (unknown mode, kind, leaf size, shape, sampler or filter)\0",
         3 => b"memory too small\0",
         4 => b"bad triangle (non-finite or out-of-range vertex)\0",
         5 => b"bad baked file (magic, version, header field, length or checksum)\0",
@@ -182,8 +214,20 @@ pub extern "C" fn rk_status_name(status: i32) -> *const c_char {
         7 => b"bad baked tree or triangles\0",
         8 => b"bad ray\0",
         9 => b"not refittable (baked structure or other triangle count)\0",
-        10 => b"RkAccel not initialised\0",
-        11 => b"too many triangles\0",
+        10 => b"RkAccel or RkRenderer not initialised\0",
+        11 => b"too large (too many triangles or objects)\0",
+        12 => b"bad sphere (non-finite or out-of-range centre, negative radius)\0",
+        13 => b"scene value not finite\0",
+        14 => b"scene value negative\0",
+        15 => b"reflectance above 1\0",
+        16 => b"scene value not positive\0",
+        17 => b"scene value out of range\0",
+        18 => b"rectangle light of zero area\0",
+        19 => b"degenerate direction (zero, or camera up along the view)\0",
+        20 => b"material index out of range\0",
+        21 => b"too many lights\0",
+        22 => b"tile outside the image\0",
+        23 => b"output buffer too small for the tile\0",
         _ => b"unknown status\0",
     };
     name.as_ptr().cast()

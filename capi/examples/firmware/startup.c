@@ -1,7 +1,8 @@
 /* Minimal Cortex-M4F start-up: vector table, .data/.bss set-up, FPU on, then main. */
 #include <stdint.h>
 
-extern uint32_t _data_start, _data_end, _data_load, _bss_start, _bss_end, _stack_top;
+#include "stack_paint.h"
+
 int main(void);
 
 void reset_handler(void) {
@@ -11,6 +12,12 @@ void reset_handler(void) {
     }
     for (uint32_t *dst = &_bss_start; dst < &_bss_end;) {
         *dst++ = 0;
+    }
+    /* Paint the free RAM between .bss and the stack, so main can measure the stack it used. */
+    uint32_t *sp;
+    __asm__ volatile("mov %0, sp" : "=r"(sp));
+    for (uint32_t *p = &_bss_end; p < sp - 16;) {
+        *p++ = STACK_PAINT;
     }
     /* CPACR: full access to coprocessors 10 and 11 (the FPU). */
     *(volatile uint32_t *)0xE000ED88u |= 0xFu << 20;

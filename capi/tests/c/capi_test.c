@@ -1,14 +1,19 @@
 /* Host test of the C interface (gcc): every status named, builds in both modes and both tree
- * kinds answering alike, typed errors for bad arguments, refit equal to a rebuild, and, given
- * a baked file (argv[1]), loading it in place and printing the check grid's hash (compared
- * with argv[2] when given: the hash `raykernel bake` printed for the tree it built).
+ * kinds answering alike, typed errors for bad arguments, refit equal to a rebuild, rendering
+ * the check scene in tiles (also from several threads at once) with the kernel's bytes
+ * (render_golden.h) and typed scene errors, and, given a baked file (argv[1]), loading it in
+ * place and printing the check grid's hash (compared with argv[2] when given: the hash
+ * `raykernel bake` printed for the tree it built).
  * Build: gcc -std=c11 -ffp-contract=off -I capi/include -I capi/examples/common
  *        capi/tests/c/capi_test.c target/debug/libraykernel_c.a -lpthread -ldl -lm */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <threads.h>
 #include "raykernel.h"
 #include "grid_hash.h"
+#include "render_golden.h"
+#include "render_scene.h"
 
 #define CHECK(cond, ...)                                      \
     do {                                                      \
@@ -57,7 +62,7 @@ static RkStatus build(uint32_t mode, uint32_t kind, const float *v, void **memor
 static int test_names(void) {
     const char *unknown = rk_status_name(999);
     CHECK(strcmp(unknown, "unknown status") == 0, "999: %s", unknown);
-    for (int s = 0; s <= RK_STATUS_ERR_TOO_LARGE; s++) {
+    for (int s = 0; s <= RK_STATUS_ERR_BUFFER_TOO_SMALL; s++) {
         const char *name = rk_status_name(s);
         CHECK(name != NULL && strcmp(name, unknown) != 0, "status %d unnamed", s);
         for (int o = 0; o < s; o++) {
@@ -142,6 +147,140 @@ static int test_builds_and_errors(void) {
     return 0;
 }
 
+/* Initialises a renderer for `scene` into fresh memory (kept in *memory). */
+static RkStatus render_init(const RkScene *scene, void **memory, RkRenderer *out, RkSceneError *error) {
+    size_t bytes = rk_render_bytes(scene);
+    *memory = malloc(bytes > 0 ? bytes : 1);
+    return rk_renderer_init(scene, *memory, bytes, out, error);
+}
+
+static int test_render(void) {
+    static uint8_t tile[3 * 64], image[3 * RK_TEST_WIDTH * RK_TEST_HEIGHT];
+    const uint32_t modes[2] = {RK_MODE_F32, RK_MODE_FIXED};
+    const uint32_t image_hash[2] = {RK_TEST_IMAGE_HASH_F32, RK_TEST_IMAGE_HASH_FIXED};
+    const uint32_t tile_hash[2] = {RK_TEST_TILE_HASH_F32, RK_TEST_TILE_HASH_FIXED};
+    for (int m = 0; m < 2; m++) {
+        for (uint32_t kind = 0; kind <= RK_KIND_BVH4; kind++) {
+            RkScene scene = rk_test_scene(modes[m], kind);
+            void *memory;
+            RkRenderer r;
+            RkSceneError e;
+            RkStatus s = render_init(&scene, &memory, &r, &e);
+            CHECK(s == RK_STATUS_OK, "render init mode %u kind %u: %s (item %u index %u field %s)", modes[m],
+                  kind, rk_status_name(s), e.item, e.index, e.field);
+            /* The whole image in 5 x 3 tiles, and the check tile in one call. */
+            uint32_t h = rk_test_render_hash(&r, 0, 0, RK_TEST_WIDTH, RK_TEST_HEIGHT, 5, 3, tile, image, &s);
+            CHECK(s == RK_STATUS_OK, "render: %s", rk_status_name(s));
+            CHECK(h == image_hash[m], "mode %u kind %u: image hash %08x, the kernel's %08x", modes[m], kind, h,
+                  image_hash[m]);
+            h = rk_test_render_hash(&r, RK_TEST_TILE_X, RK_TEST_TILE_Y, RK_TEST_TILE_W, RK_TEST_TILE_H,
+                                    RK_TEST_TILE_W, RK_TEST_TILE_H, tile, image, &s);
+            CHECK(s == RK_STATUS_OK && h == tile_hash[m], "mode %u kind %u: tile hash %08x, the kernel's %08x",
+                  modes[m], kind, h, tile_hash[m]);
+            CHECK(rk_render_tile(&r, RK_TEST_WIDTH - 1, 0, 2, 1, tile, sizeof tile) == RK_STATUS_ERR_BAD_TILE,
+                  "tile outside the image");
+            CHECK(rk_render_tile(&r, 0, 0, 8, 8, tile, sizeof tile - 1) == RK_STATUS_ERR_BUFFER_TOO_SMALL,
+                  "buffer too small");
+            free(memory);
+        }
+        RkScene scene = rk_test_scene(modes[m], 0);
+        printf("mode %u: render hash %08x, tile %08x (bvh and bvh4); renderer memory %zu bytes\n", modes[m],
+               image_hash[m], tile_hash[m], rk_render_bytes(&scene));
+    }
+    /* Typed scene errors name the value at fault. */
+    RkScene scene = rk_test_scene(RK_MODE_F32, 0);
+    RkObject objects[5];
+    memcpy(objects, rk_test_objects, sizeof objects);
+    objects[3].material = 9;
+    scene.objects = objects;
+    void *memory;
+    RkRenderer r;
+    RkSceneError e;
+    RkStatus s = render_init(&scene, &memory, &r, &e);
+    CHECK(s == RK_STATUS_ERR_BAD_INDEX && e.item == RK_ITEM_OBJECT && e.index == 3 && strcmp(e.field, "material") == 0,
+          "bad material index: %s, item %u index %u field %s", rk_status_name(s), e.item, e.index, e.field);
+    CHECK(rk_render_tile(&r, 0, 0, 1, 1, tile, 3) == RK_STATUS_ERR_NOT_INITIALISED, "renderer after a failed init");
+    free(memory);
+    scene = rk_test_scene(RK_MODE_F32, 0);
+    scene.camera.vfov_deg = 180.0f;
+    s = render_init(&scene, &memory, &r, &e);
+    CHECK(s == RK_STATUS_ERR_OUT_OF_RANGE && e.item == RK_ITEM_CAMERA && strcmp(e.field, "vfov_deg") == 0,
+          "field of view: %s, field %s", rk_status_name(s), e.field);
+    free(memory);
+    scene = rk_test_scene(RK_MODE_FIXED, 0);
+    static float far[2 * 9];
+    memcpy(far, rk_test_floor, sizeof far);
+    far[9] = 9000.0f;
+    memcpy(objects, rk_test_objects, sizeof objects);
+    objects[0].data = far;
+    scene.objects = objects;
+    s = render_init(&scene, &memory, &r, &e);
+    CHECK(s == RK_STATUS_ERR_BAD_TRIANGLE && e.item == RK_ITEM_OBJECT && e.index == 0,
+          "vertex beyond the fixed-point range: %s", rk_status_name(s));
+    free(memory);
+    scene = rk_test_scene(RK_MODE_F32, 0);
+    size_t bytes = rk_render_bytes(&scene);
+    memory = malloc(bytes);
+    CHECK(rk_renderer_init(&scene, memory, bytes / 2, &r, NULL) == RK_STATUS_ERR_MEMORY_TOO_SMALL, "small memory");
+    CHECK(rk_renderer_init(NULL, memory, bytes, &r, NULL) == RK_STATUS_ERR_NULL, "null scene");
+    CHECK(rk_render_bytes(NULL) == 0, "null scene: no size");
+    free(memory);
+    return 0;
+}
+
+enum { THREADS = 4 };
+
+typedef struct {
+    const RkRenderer *renderer;
+    int first_row;
+    uint8_t *image;
+    RkStatus status;
+} RowJob;
+
+/* Renders every THREADS-th row, from `first_row`, straight into its place in the image. */
+static int render_rows(void *arg) {
+    RowJob *job = arg;
+    job->status = RK_STATUS_OK;
+    for (uint32_t y = (uint32_t)job->first_row; y < RK_TEST_HEIGHT; y += THREADS) {
+        uint8_t *row = job->image + 3u * y * RK_TEST_WIDTH;
+        RkStatus s = rk_render_tile(job->renderer, 0, y, RK_TEST_WIDTH, 1, row, 3u * RK_TEST_WIDTH);
+        if (s != RK_STATUS_OK) {
+            job->status = s;
+        }
+    }
+    return 0;
+}
+
+/* One renderer, tiles rendered by several threads at once: the kernel's image. */
+static int test_render_threads(void) {
+    static uint8_t image[3 * RK_TEST_WIDTH * RK_TEST_HEIGHT];
+    RkScene scene = rk_test_scene(RK_MODE_FIXED, RK_KIND_BVH4);
+    void *memory;
+    RkRenderer r;
+    RkSceneError e;
+    RkStatus s = render_init(&scene, &memory, &r, &e);
+    CHECK(s == RK_STATUS_OK, "render init: %s", rk_status_name(s));
+    thrd_t threads[THREADS];
+    RowJob jobs[THREADS];
+    for (int t = 0; t < THREADS; t++) {
+        jobs[t] = (RowJob){&r, t, image, RK_STATUS_OK};
+        CHECK(thrd_create(&threads[t], render_rows, &jobs[t]) == thrd_success, "thread %d", t);
+    }
+    for (int t = 0; t < THREADS; t++) {
+        thrd_join(threads[t], NULL);
+        CHECK(jobs[t].status == RK_STATUS_OK, "thread %d: %s", t, rk_status_name(jobs[t].status));
+    }
+    uint32_t h = 0x811c9dc5u;
+    for (size_t i = 0; i < sizeof image; i++) {
+        h = rk_fnv1a(h, image[i], 1);
+    }
+    CHECK(h == RK_TEST_IMAGE_HASH_FIXED, "%d threads: image hash %08x, the kernel's %08x", THREADS, h,
+          RK_TEST_IMAGE_HASH_FIXED);
+    printf("render on %d threads at once: the kernel's image\n", THREADS);
+    free(memory);
+    return 0;
+}
+
 static int test_baked(const char *path, const char *expect) {
     FILE *f = fopen(path, "rb");
     CHECK(f != NULL, "cannot open %s", path);
@@ -178,7 +317,7 @@ static int test_baked(const char *path, const char *expect) {
 }
 
 int main(int argc, char **argv) {
-    if (test_names() || test_builds_and_errors()) {
+    if (test_names() || test_builds_and_errors() || test_render() || test_render_threads()) {
         return 1;
     }
     if (argc > 1 && test_baked(argv[1], argc > 2 ? argv[2] : NULL)) {
