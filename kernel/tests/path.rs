@@ -484,3 +484,48 @@ fn plan_records_the_integrator_and_checks_the_length() {
         ("max_length", raykernel::render::Problem::NotPositive)
     );
 }
+
+/// The default scene's ceiling, the block's side and the core shadows get no direct light:
+/// black under the direct integrator, lit by interreflection under the path integrator
+/// (what stays black there is the open front of the box reflected in the spheres).
+#[test]
+fn the_default_scene_ceiling_is_lit_under_the_path_integrator() {
+    let d = scenes::CORNELL;
+    let mut tris = vec![Triangle::<f32> { v: [[0.0; 3]; 3] }; d.triangles.len()];
+    let mut spheres = vec![sphere::<f32>([0.0; 3], 1.0); d.spheres.len()];
+    d.triangles_into(&mut tris).unwrap();
+    d.spheres_into(&mut spheres).unwrap();
+    let mut objects = vec![Object::new(Shape::Triangles(&[]), 0); d.objects.len()];
+    let scene = d.scene(&tris, &spheres, &mut objects).unwrap();
+    let (w, h) = (48usize, 48usize);
+    let st = Settings {
+        width: w as u32,
+        height: h as u32,
+        spp: 8,
+        ..d.settings
+    };
+    let direct = render(&scene, st);
+    let path = render(
+        &scene,
+        Settings {
+            integrator: Integrator::Path { max_length: 5 },
+            ..st
+        },
+    );
+    let black = |p: &[f32; 3]| *p == [0.0; 3];
+    // The top sixth of the image is ceiling between the side walls.
+    let ceiling: Vec<usize> = (0..w * h / 6).filter(|&i| black(&direct[i])).collect();
+    assert!(
+        ceiling.len() > w * h / 6 / 2,
+        "direct: {} black ceiling pixels",
+        ceiling.len()
+    );
+    let unlit = ceiling.iter().filter(|&&i| black(&path[i])).count();
+    assert_eq!(unlit, 0, "path: ceiling pixels still black");
+    let count = |px: &[[f32; 3]]| px.iter().filter(|p| black(p)).count();
+    let (d_black, p_black) = (count(&direct), count(&path));
+    assert!(
+        4 * p_black < d_black,
+        "black pixels: direct {d_black}, path {p_black}"
+    );
+}
