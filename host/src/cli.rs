@@ -9,13 +9,17 @@ use crate::classify::{classify, Classification};
 use crate::compare::{compare_hits, Comparison, DEFAULT_REL};
 use crate::console::Console;
 use crate::error::Error;
-use crate::limits::{check_memory, check_settings, render_bytes, MAX_DEPTH, MAX_SIDE, MAX_SPP};
+use crate::limits::{
+    check_memory, check_settings, render_bytes, MAX_DEPTH, MAX_PATH_LENGTH, MAX_SIDE, MAX_SPP,
+};
 use crate::obj::{load_obj, point_error_text};
 use crate::output::{Format, Reserved};
 use crate::rayfile::{read_hits, read_rays, write_hits, RayRecord};
 use crate::render::{encode_pfm, encode_png, mode_name, plan, render, RenderError, RenderOptions};
 use crate::scene::{resolve_scene, DEFAULT_SCENE};
-use crate::scenefile::{scene_file_text, spec_to_scene_file, FilterName, SamplerName};
+use crate::scenefile::{
+    integrator_over, scene_file_text, spec_to_scene_file, FilterName, IntegratorName, SamplerName,
+};
 use crate::spec::{eye_to_look_at, SceneOrigin, SceneSpec};
 use crate::trace::{accel_parser, trace, Builder, Mode, TraceConfig};
 use clap::builder::RangedU64ValueParser;
@@ -51,9 +55,9 @@ pub enum Command {
     /// --scene and --rays, also check each differing ray passes within quantization error of an
     /// edge of a reported triangle.
     CompareHits(CompareArgs),
-    /// Render a scene with the distribution ray tracer: a built-in scene (default `cornell`),
-    /// a scene file (.json, see docs/SCENE_FORMAT.md) or an OBJ mesh; PNG out, optionally
-    /// linear PFM; parallel over tiles.
+    /// Render a scene (distribution ray tracer, or path tracer with `--integrator path`): a
+    /// built-in scene (default `cornell`), a scene file (.json, see docs/SCENE_FORMAT.md) or an
+    /// OBJ mesh; PNG out, optionally linear PFM; parallel over tiles.
     Render(RenderArgs),
     /// Render scenes every way (kernel single-threaded, host tiles at several thread counts
     /// and tile sizes, every accelerator) and check all are byte-identical.
@@ -93,6 +97,14 @@ pub struct SettingsArgs {
     /// Most reflection bounces [default: the scene's].
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(MAX_DEPTH)))]
     pub max_depth: Option<u32>,
+    /// Light transport: `direct` (distribution ray tracing) or `path` (path tracing with light
+    /// sampling and MIS) [default: the scene's].
+    #[arg(long, value_enum)]
+    pub integrator: Option<IntegratorName>,
+    /// Most segments of a path, camera ray included (2: direct light; each more adds a bounce),
+    /// for the path integrator [default: the scene's, else 5].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_PATH_LENGTH)))]
+    pub max_path_length: Option<u32>,
     /// Sample placement [default: the scene's].
     #[arg(long, value_enum)]
     pub sampler: Option<SamplerName>,
@@ -129,6 +141,7 @@ impl SettingsArgs {
             height,
             spp: self.spp.unwrap_or(base.spp),
             max_depth: self.max_depth.unwrap_or(base.max_depth),
+            integrator: integrator_over(self.integrator, self.max_path_length, base.integrator),
             sampler: self.sampler.map_or(base.sampler, Into::into),
             filter: self.filter.map_or(base.filter, Into::into),
             seed: self.seed.unwrap_or(base.seed),

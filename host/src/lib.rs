@@ -13,7 +13,7 @@
 //! - [`spec`]: a scene the host owns, and kernel errors mapped back to its fields,
 //! - [`scenefile`]: the JSON scene format (load, dump),
 //! - [`scene`]: what a SCENE argument names (built-in, scene file, OBJ with camera and lights),
-//! - [`render`]: parallel tiles over the kernel's distribution ray tracer, PNG and PFM out,
+//! - [`render`]: parallel tiles over the kernel's renderer, PNG and PFM out,
 //!   [`exr`]: OpenEXR out,
 //! - [`check`]: every way of rendering gives the same bytes,
 //! - [`snapshot`]: exact comparison with golden images and hashes,

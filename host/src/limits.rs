@@ -5,7 +5,7 @@
 //! more memory than there is nor keep it busy forever. The memory a render needs is estimated
 //! from the same figures and compared with what the process may still use.
 
-use raykernel::render::Settings;
+use raykernel::render::{Integrator, Settings};
 
 /// Largest image, in pixels (`width × height`): 8192 × 8192.
 pub const MAX_PIXELS: u64 = 1 << 26;
@@ -15,6 +15,8 @@ pub const MAX_SIDE: u32 = 1 << 16;
 pub const MAX_SPP: u32 = 1 << 20;
 /// Most reflection bounces.
 pub const MAX_DEPTH: u32 = 64;
+/// Longest path (segments) of the path integrator.
+pub const MAX_PATH_LENGTH: u32 = 1024;
 /// Most materials in a scene.
 pub const MAX_MATERIALS: usize = 1 << 16;
 /// Most objects in a scene.
@@ -92,6 +94,14 @@ pub fn check_settings(s: &Settings) -> Result<(), OverLimit> {
             "settings.max_depth",
             format!("{} bounces; the limit is {MAX_DEPTH}", s.max_depth),
         );
+    }
+    if let Integrator::Path { max_length } = s.integrator {
+        if max_length > MAX_PATH_LENGTH {
+            return over(
+                "settings.max_path_length",
+                format!("{max_length} segments; the limit is {MAX_PATH_LENGTH}"),
+            );
+        }
     }
     Ok(())
 }

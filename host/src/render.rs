@@ -1,4 +1,4 @@
-//! The host's render path: the kernel's distribution ray tracer ([`raykernel::render`]) over
+//! The host's render path: the kernel's renderer ([`raykernel::render`]) over
 //! tiles in parallel (rayon, a local thread pool), and the image files (PNG, PFM).
 //!
 //! Every pixel is a pure function of the scene, the settings and its position, so tiles can run

@@ -293,6 +293,7 @@ pub fn lit_mesh_scene(
             shape: ShapeRange::Triangles { first: 0, count },
             material: 0,
             motion: [0.0; 3],
+            emission: [0.0; 3],
         }],
         object_sources: vec![source],
         materials: vec![Material::Diffuse { albedo: OBJ_ALBEDO }],

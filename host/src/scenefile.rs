@@ -19,7 +19,7 @@ use crate::obj::load_obj;
 use crate::spec::{eye_to_look_at, ObjectSource, SceneOrigin, SceneSpec};
 use raykernel::render::scenes::{ObjectData, SceneData, ShapeRange, SphereData};
 use raykernel::render::MAX_LIGHTS;
-use raykernel::render::{Camera, Filter, Light, Material, SamplerKind, Settings};
+use raykernel::render::{Camera, Filter, Integrator, Light, Material, SamplerKind, Settings};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::HashMap;
@@ -38,10 +38,15 @@ pub const DEFAULT_SETTINGS: Settings = Settings {
     height: 512,
     spp: 64,
     max_depth: 4,
+    integrator: Integrator::Direct,
     sampler: SamplerKind::Stratified,
     filter: Filter::Box,
     seed: 0,
 };
+
+/// Path length (segments) of the path integrator when a file or flag names it without one:
+/// four bounces.
+pub const DEFAULT_MAX_PATH_LENGTH: u32 = 5;
 
 /// A whole scene file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -109,9 +114,15 @@ pub struct SettingsEntry {
     /// Samples per pixel.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spp: Option<u32>,
-    /// Most reflection bounces.
+    /// Most mirror and glossy bounces (direct integrator).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_depth: Option<u32>,
+    /// Light transport.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub integrator: Option<IntegratorName>,
+    /// Most segments of a path, camera ray included (path integrator).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_path_length: Option<u32>,
     /// Sample placement.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sampler: Option<SamplerName>,
@@ -121,6 +132,48 @@ pub struct SettingsEntry {
     /// Seed of every random value.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seed: Option<u32>,
+}
+
+/// `settings.integrator`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum IntegratorName {
+    /// Distribution ray tracing: direct light at the first diffuse surface.
+    Direct,
+    /// Path tracing with light sampling and MIS.
+    Path,
+}
+
+impl IntegratorName {
+    /// The name of `integrator`.
+    #[must_use]
+    pub const fn of(integrator: Integrator) -> Self {
+        match integrator {
+            Integrator::Direct => Self::Direct,
+            Integrator::Path { .. } => Self::Path,
+        }
+    }
+}
+
+/// The integrator `name` and `max_length` ask for over `base` (each `None` keeps `base`'s; a
+/// path integrator named over a direct one gets [`DEFAULT_MAX_PATH_LENGTH`]; a length under
+/// the direct integrator is kept for nothing).
+#[must_use]
+pub fn integrator_over(
+    name: Option<IntegratorName>,
+    max_length: Option<u32>,
+    base: Integrator,
+) -> Integrator {
+    let base_length = match base {
+        Integrator::Path { max_length } => max_length,
+        Integrator::Direct => DEFAULT_MAX_PATH_LENGTH,
+    };
+    match name.unwrap_or(IntegratorName::of(base)) {
+        IntegratorName::Direct => Integrator::Direct,
+        IntegratorName::Path => Integrator::Path {
+            max_length: max_length.unwrap_or(base_length),
+        },
+    }
 }
 
 /// `settings.sampler`.
@@ -258,6 +311,10 @@ pub struct ObjectEntry {
     /// Displacement over the shutter interval (default none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub motion: Option<[f32; 3]>,
+    /// Radiance the object's surfaces emit on top of what the material reflects (default
+    /// none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emission: Option<[f32; 3]>,
 }
 
 /// A sphere.
@@ -646,6 +703,7 @@ fn resolve(file: SceneFile, path: &Path, stem: &str) -> Result<SceneSpec, Error>
             shape,
             material: index_u32(material),
             motion: o.motion.unwrap_or([0.0; 3]),
+            emission: o.emission.unwrap_or([0.0; 3]),
         });
         spec.object_sources.push(source);
     }
@@ -687,6 +745,7 @@ pub fn settings(entry: &SettingsEntry, base: Settings) -> Settings {
         height: entry.height.unwrap_or(base.height),
         spp: entry.spp.unwrap_or(base.spp),
         max_depth: entry.max_depth.unwrap_or(base.max_depth),
+        integrator: integrator_over(entry.integrator, entry.max_path_length, base.integrator),
         sampler: entry.sampler.map_or(base.sampler, Into::into),
         filter: entry.filter.map_or(base.filter, Into::into),
         seed: entry.seed.unwrap_or(base.seed),
@@ -797,6 +856,7 @@ pub fn to_scene_file(d: &SceneData<'_>, material_names: &[String]) -> SceneFile 
                 transform: None,
                 material: name(o.material as usize),
                 motion: (o.motion != [0.0; 3]).then_some(o.motion),
+                emission: (o.emission != [0.0; 3]).then_some(o.emission),
             }
         })
         .collect();
@@ -853,6 +913,13 @@ pub fn to_scene_file(d: &SceneData<'_>, material_names: &[String]) -> SceneFile 
             height: Some(s.height),
             spp: Some(s.spp),
             max_depth: Some(s.max_depth),
+            // Written for the path integrator only (files of direct scenes stay as they were).
+            integrator: matches!(s.integrator, Integrator::Path { .. })
+                .then_some(IntegratorName::Path),
+            max_path_length: match s.integrator {
+                Integrator::Path { max_length } => Some(max_length),
+                Integrator::Direct => None,
+            },
             sampler: Some(s.sampler.into()),
             filter: Some(s.filter.into()),
             seed: Some(s.seed),

@@ -276,3 +276,28 @@ fn bad_arguments_and_files_fail_with_one_message() {
         assert_fails(&host(&a), 2, needle);
     }
 }
+
+#[test]
+fn the_path_integrator_is_chosen_on_the_command_line() {
+    let out = host(&[
+        "render",
+        "cornell",
+        "--integrator",
+        "path",
+        "--max-path-length",
+        "6",
+        "--explain",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        stdout.contains("path tracing (max length 6 segments, Russian roulette after 3"),
+        "{stdout}"
+    );
+    let out = host(&["render", "cornell", "--max-path-length", "0", "--explain"]);
+    assert!(!out.status.success());
+}

@@ -141,6 +141,7 @@ fn one_pixel(spp: u32, sampler: SamplerKind) -> Settings {
         sampler,
         filter: Filter::Box,
         seed: 5,
+        ..Settings::default()
     }
 }
 

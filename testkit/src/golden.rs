@@ -10,7 +10,9 @@
 pub use crate::Rng;
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::render::scenes::{self, SceneData};
-use raykernel::render::{Object, ObjectSlot, RenderMemory, Renderer, Shape, Tile};
+use raykernel::render::{
+    Integrator, Object, ObjectSlot, RenderMemory, Renderer, Settings, Shape, Tile,
+};
 use raykernel::spawn::SpawnScalar;
 use raykernel::{
     Accel, AccelMemory, Bvh, BvhFamily, Hit, Linear, Node, Primitive, Ray, Scalar, Sphere,
@@ -28,7 +30,7 @@ const CENTER: [f32; 3] = [0.375, -0.25, 0.625];
 const RADIUS: f32 = 2.0;
 
 /// Every golden case, in file order.
-pub const NAMES: [&str; 18] = [
+pub const NAMES: [&str; 20] = [
     "rays_f32",
     "rays_fixed",
     "linear_f32",
@@ -47,6 +49,8 @@ pub const NAMES: [&str; 18] = [
     "render_spheres_fixed",
     "render_motion_f32",
     "render_motion_fixed",
+    "render_cornell_path_f32",
+    "render_cornell_path_fixed",
 ];
 
 /// What went wrong while computing a case.
@@ -327,6 +331,20 @@ fn spheres_case<S: Bits>() -> Result<u64, Fail> {
 /// Largest built-in scene, in triangles, spheres and objects (the buffers below are sized
 /// for it; a bigger scene fails with [`Fail::Rejected`]).
 const RENDER_TRIS: usize = 24;
+/// The default scene under the path integrator (four bounces), small enough for the M0's
+/// render time: every path feature (diffuse, glossy and mirror bounces, light sampling with
+/// MIS, Russian roulette) with the lens, motion and the area light.
+pub const CORNELL_PATH: SceneData<'static> = SceneData {
+    settings: Settings {
+        width: 32,
+        height: 32,
+        spp: 4,
+        integrator: Integrator::Path { max_length: 5 },
+        ..scenes::CORNELL.settings
+    },
+    ..scenes::CORNELL
+};
+
 const RENDER_SPHERES: usize = 4;
 const RENDER_OBJECTS: usize = 8;
 /// Widest built-in render (pixels), for the one-row buffer.
@@ -397,6 +415,8 @@ pub fn compute_render(name: &str) -> Result<u64, Fail> {
         "render_spheres_fixed" => render_hash::<I16F16>(&scenes::SPHERES),
         "render_motion_f32" => render_hash::<f32>(&scenes::MOTION),
         "render_motion_fixed" => render_hash::<I16F16>(&scenes::MOTION),
+        "render_cornell_path_f32" => render_hash::<f32>(&CORNELL_PATH),
+        "render_cornell_path_fixed" => render_hash::<I16F16>(&CORNELL_PATH),
         _ => Err(Fail::UnknownCase),
     }
 }

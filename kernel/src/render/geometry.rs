@@ -95,6 +95,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
             if !super::scene::finite3(o.motion) {
                 return Err(err(i, "motion", Problem::NonFinite));
             }
+            super::scene::check_rgb(o.emission, false).map_err(|p| err(i, "emission", p))?;
             let bounds = match o.shape {
                 Shape::Triangles(t) => union_bounds(t),
                 Shape::Spheres(s) if F::SPHERES => union_bounds(s),
@@ -112,6 +113,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
                 shape: o.shape,
                 base,
                 material: o.material,
+                emission: o.emission,
                 motion,
                 swept,
             };
@@ -300,6 +302,8 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
 
     /// The point a hit lies on: world position, unit geometric normal (not yet facing the
     /// ray), and what [`SurfacePoint::spawn_origin`] needs to leave it. `None` for lights.
+    /// Inlined on hosted targets into both integrators (see `lighting::visible`).
+    #[cfg_attr(not(target_os = "none"), inline(always))]
     pub(crate) fn surface_point(
         &self,
         ray: &Ray<S>,

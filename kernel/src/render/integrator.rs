@@ -1,15 +1,17 @@
-//! The bounce loop: camera ray, closest hit, emission, direct light at diffuse surfaces,
-//! reflection rays at mirror and glossy ones. Iterative; each step does only what the render
-//! plan says the scene needs.
+//! The direct integrator's bounce loop: camera ray, closest hit, emission, direct light at
+//! diffuse surfaces, reflection rays at mirror and glossy ones. Iterative; each step does only
+//! what the render plan says the scene needs. Also the camera-ray-only loop and the helpers
+//! the path integrator ([`super::path`]) shares.
 
 use super::geometry::Surface;
-use super::sampling::{phong_lobe, tent, to_world, uniform_cone, SampleStream};
+use super::lighting::{light_sum, Lobe};
+use super::sampling::{phong_lobe, tent, to_world, SampleStream};
 use super::scene::{Filter, Light, Material};
-use super::surface::{dir_in_mode, SurfacePoint};
+use super::surface::dir_in_mode;
 use super::{RenderPlan, RenderStats, Renderer};
 use crate::accel::AccelFamily;
 use crate::accel::NoStats;
-use crate::geom::spawn::{shadow_t_max, SpawnScalar};
+use crate::geom::spawn::SpawnScalar;
 use crate::geom::Ray;
 use core::f32::consts::FRAC_1_PI;
 use glam::Vec3;
@@ -65,6 +67,9 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
             }
             Surface::Object { object, .. } => object,
         };
+        if plan.emitting_objects {
+            radiance += throughput * emission_of(r, object);
+        }
         // Emitters end the path: no surface point needed.
         let material = match material_of(r, object) {
             None => break,
@@ -84,7 +89,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
         match material {
             Material::Emissive { .. } => break, // ended the path above
             Material::Diffuse { albedo } => {
-                let e = direct_light(r, &sp, nf, time, stream, stats);
+                let e = light_sum(r, &sp, nf, Lobe::Diffuse, false, time, stream, stats);
                 radiance += throughput * Vec3::from_array(*albedo) * (e * FRAC_1_PI);
                 break;
             }
@@ -163,13 +168,25 @@ pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>>(
 
 /// Object `object`'s material (`None` only for an index the renderer's checks rule out).
 #[inline]
-fn material_of<'r, S: SpawnScalar, F: AccelFamily<S>>(
+pub(super) fn material_of<'r, S: SpawnScalar, F: AccelFamily<S>>(
     r: &'r Renderer<'_, S, F>,
     object: usize,
 ) -> Option<&'r Material> {
     r.geometry
         .object(object)
         .and_then(|o| r.materials.get(o.material as usize))
+}
+
+/// Radiance object `object` emits ([`super::Object::emission`]; zero for an index the
+/// renderer's checks rule out).
+#[inline]
+pub(super) fn emission_of<S: SpawnScalar, F: AccelFamily<S>>(
+    r: &Renderer<'_, S, F>,
+    object: usize,
+) -> Vec3 {
+    r.geometry
+        .object(object)
+        .map_or(Vec3::ZERO, |o| Vec3::from_array(o.emission))
 }
 
 /// The path's direction at bounce `depth` as a unit vector: the camera's (depth 0) is
@@ -183,12 +200,12 @@ fn unit_at(dir: Vec3, depth: u32) -> Vec3 {
     }
 }
 
-fn reflect(d: Vec3, n: Vec3) -> Vec3 {
+pub(super) fn reflect(d: Vec3, n: Vec3) -> Vec3 {
     d - n * (2.0 * d.dot(n))
 }
 
 /// Radiance a camera or reflection ray sees on light `i`'s surface.
-fn light_seen<S: SpawnScalar, F: AccelFamily<S>>(
+pub(super) fn light_seen<S: SpawnScalar, F: AccelFamily<S>>(
     r: &Renderer<'_, S, F>,
     i: usize,
     dir: Vec3,
@@ -204,130 +221,4 @@ fn light_seen<S: SpawnScalar, F: AccelFamily<S>>(
         (Some(Light::Sphere { radiance, .. }), _) => Vec3::from_array(*radiance),
         _ => Vec3::ZERO,
     }
-}
-
-/// Irradiance-like sum `Σ L·cos θ / pdf` over every light at a diffuse point (the caller
-/// multiplies by `albedo / π`), one sample per area light, each tested by a shadow ray.
-fn direct_light<S: SpawnScalar, F: AccelFamily<S>>(
-    r: &Renderer<'_, S, F>,
-    sp: &SurfacePoint<'_, S>,
-    nf: Vec3,
-    time: f32,
-    stream: &mut SampleStream,
-    stats: &mut RenderStats,
-) -> Vec3 {
-    let p = sp.position;
-    let pf = Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
-    let mut sum = Vec3::ZERO;
-    for light in r.lights {
-        // Each arm gives the target point, the unoccluded contribution, or nothing.
-        let (target, contribution) = match *light {
-            Light::Point {
-                position,
-                intensity,
-            } => {
-                let to = Vec3::from_array(position) - pf;
-                let d2 = to.length_squared();
-                let cos = nf.dot(to) / libm::sqrtf(d2);
-                if !(cos > 0.0 && d2 > 0.0) {
-                    continue;
-                }
-                (position, Vec3::from_array(intensity) * (cos / d2))
-            }
-            Light::Rect {
-                corner,
-                edge_u,
-                edge_v,
-                radiance,
-            } => {
-                let (a, b) = stream.next_2d();
-                let (eu, ev) = (Vec3::from_array(edge_u), Vec3::from_array(edge_v));
-                let y = Vec3::from_array(corner) + eu * a + ev * b;
-                let to = y - pf;
-                let d2 = to.length_squared();
-                let dist = libm::sqrtf(d2);
-                let cross = eu.cross(ev);
-                let area = cross.length();
-                let cos = nf.dot(to) / dist;
-                let cos_l = -cross.dot(to) / (area * dist);
-                if !(cos > 0.0 && cos_l > 0.0 && d2 > 0.0) {
-                    continue;
-                }
-                (
-                    y.to_array(),
-                    Vec3::from_array(radiance) * (cos * cos_l * area / d2),
-                )
-            }
-            Light::Sphere {
-                center,
-                radius,
-                radiance,
-            } => {
-                let (a, b) = stream.next_2d();
-                let to_c = Vec3::from_array(center) - pf;
-                let dc2 = to_c.length_squared();
-                let r2 = radius * radius;
-                if dc2 <= r2 || dc2.is_nan() {
-                    continue;
-                }
-                let dc = libm::sqrtf(dc2);
-                let axis = to_c / dc;
-                let cos_max = libm::sqrtf(1.0 - r2 / dc2);
-                let wi = to_world(uniform_cone(a, b, cos_max), axis);
-                let cos = nf.dot(wi);
-                if cos <= 0.0 || cos.is_nan() {
-                    continue;
-                }
-                // Nearest root of |p + t·wi − c| = r (the cone guarantees one, up to rounding).
-                let b_half = wi.dot(to_c);
-                let disc = b_half * b_half - (dc2 - r2);
-                let t = b_half - libm::sqrtf(if disc > 0.0 { disc } else { 0.0 });
-                let solid_angle = 2.0 * core::f32::consts::PI * (1.0 - cos_max);
-                (
-                    (pf + wi * t).to_array(),
-                    Vec3::from_array(radiance) * (cos * solid_angle),
-                )
-            }
-        };
-        if contribution == Vec3::ZERO {
-            continue;
-        }
-        stats.shadow_rays += 1;
-        if visible(r, sp, target, time) {
-            sum += contribution;
-        }
-    }
-    sum
-}
-
-/// True if nothing blocks the segment from the surface point to `target`.
-fn visible<S: SpawnScalar, F: AccelFamily<S>>(
-    r: &Renderer<'_, S, F>,
-    sp: &SurfacePoint<'_, S>,
-    target: [f32; 3],
-    time: f32,
-) -> bool {
-    let p = sp.position;
-    let toward = [
-        (f64::from(target[0]) - p[0]) as f32,
-        (f64::from(target[1]) - p[1]) as f32,
-        (f64::from(target[2]) - p[2]) as f32,
-    ];
-    let origin = sp.spawn_origin(toward);
-    let o = origin.map(S::to_f64);
-    let d = [
-        f64::from(target[0]) - o[0],
-        f64::from(target[1]) - o[1],
-        f64::from(target[2]) - o[2],
-    ];
-    let len = libm::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    let dir = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32).normalize_or_zero();
-    let Ok(ray) = Ray::<S>::new(S::array_to_vec(origin), dir_in_mode::<S>(dir.to_array())) else {
-        // Origin and target coincide (or the origin left the range): count as lit.
-        return true;
-    };
-    let Ok(ray) = ray.with_interval(S::ZERO, shadow_t_max::<S>(len)) else {
-        return true;
-    };
-    !r.geometry.occluded(&ray, time, &mut NoStats)
 }

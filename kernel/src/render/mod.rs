@@ -19,10 +19,12 @@
 mod camera;
 mod geometry;
 mod integrator;
+mod lighting;
 mod lights;
 mod memory;
 mod motion;
 mod objects;
+mod path;
 pub mod sampling;
 mod scene;
 pub mod scenes;
@@ -34,7 +36,8 @@ pub use memory::{memory_needed, RenderMemory, RenderMemoryNeeded};
 pub use objects::ObjectSlot;
 pub use sampling::SamplerKind;
 pub use scene::{
-    Camera, Filter, Item, Light, Material, Object, Problem, Rgb, Scene, SceneError, Settings, Shape,
+    Camera, Filter, Integrator, Item, Light, Material, Object, Problem, Rgb, Scene, SceneError,
+    Settings, Shape,
 };
 pub use srgb::encode_srgb8;
 pub use surface::SPHERE_SPAWN_FACTOR;
@@ -68,21 +71,33 @@ pub struct RenderPlan {
     pub point_lights: u32,
     /// Area lights (one sample and shadow ray each per diffuse hit: soft shadows).
     pub area_lights: u32,
-    /// Some object is mirror or glossy: reflection rays are traced.
+    /// Light transport: [`Integrator::Direct`], or [`Integrator::Path`] with its length.
+    pub integrator: Integrator,
+    /// Some object emits ([`Object::emission`]): hits add its radiance.
+    pub emitting_objects: bool,
+    /// Some radiance is found only by rays that hit it, not by sampling the lights: a
+    /// background that is not black, an emissive material or an emitting object. Without it
+    /// the path integrator ends a path at its last vertex once the lights are sampled.
+    pub unsampled_emission: bool,
+    /// Direct integrator: some object is mirror or glossy, so reflection rays are traced.
     pub reflections: bool,
-    /// Some object is glossy: reflection rays sample a lobe.
+    /// Direct integrator: some object is glossy, so reflection rays sample a lobe.
     pub glossy: bool,
-    /// Most reflection bounces (0 without reflecting materials).
+    /// Direct integrator: most reflection bounces (0 without reflecting materials, and under
+    /// the path integrator).
     pub max_depth: u32,
 }
 
 impl RenderPlan {
-    /// True when camera rays are all a render casts: one sample at each pixel centre, a
-    /// pinhole, nothing moving, no lights and nothing reflecting. The renderer then runs a
-    /// first-hit loop without sample streams or a bounce loop (the same bits).
+    /// True when camera rays are all a render casts: the direct integrator, one sample at each
+    /// pixel centre, a pinhole, nothing moving, no lights, no emitting objects and nothing
+    /// reflecting. The renderer then runs a first-hit loop without sample streams or a bounce
+    /// loop (the same bits).
     #[must_use]
     pub const fn camera_rays_only(&self) -> bool {
-        self.pixel_centre
+        matches!(self.integrator, Integrator::Direct)
+            && !self.emitting_objects
+            && self.pixel_centre
             && !self.lens
             && !self.motion
             && !self.reflections
@@ -97,7 +112,9 @@ impl RenderPlan {
                 .iter()
                 .any(|o| scene.materials.get(o.material as usize).is_some_and(f))
         };
-        let reflections = used(Material::reflects) && settings.max_depth > 0;
+        let direct = matches!(settings.integrator, Integrator::Direct);
+        let emitting_objects = scene.objects.iter().any(|o| o.emission != [0.0; 3]);
+        let reflections = direct && used(Material::reflects) && settings.max_depth > 0;
         let count = |area: bool| scene.lights.iter().filter(|l| l.is_area() == area).count() as u32;
         Self {
             spp: settings.spp,
@@ -111,6 +128,11 @@ impl RenderPlan {
                 .any(|o| o.moves() && !o.shape.is_empty()),
             point_lights: count(false),
             area_lights: count(true),
+            integrator: settings.integrator,
+            emitting_objects,
+            unsampled_emission: emitting_objects
+                || scene.background != [0.0; 3]
+                || used(|m| matches!(m, Material::Emissive { .. })),
             reflections,
             glossy: reflections && used(|m| matches!(m, Material::Glossy { .. })),
             max_depth: if reflections { settings.max_depth } else { 0 },
@@ -134,17 +156,31 @@ impl fmt::Display for RenderPlan {
         }
         write!(
             f,
-            "; depth of field {}; motion blur {}; lights: {} point, {} area (soft shadows {}); \
-             reflections {} (glossy {}, max depth {})",
+            "; depth of field {}; motion blur {}; lights: {} point, {} area (soft shadows {})",
             on(self.lens),
             on(self.motion),
             self.point_lights,
             self.area_lights,
             on(self.area_lights > 0),
-            on(self.reflections),
-            on(self.glossy),
-            self.max_depth
         )?;
+        if self.emitting_objects {
+            write!(f, "; emitting objects")?;
+        }
+        match self.integrator {
+            Integrator::Direct => write!(
+                f,
+                "; reflections {} (glossy {}, max depth {})",
+                on(self.reflections),
+                on(self.glossy),
+                self.max_depth
+            )?,
+            Integrator::Path { max_length } => write!(
+                f,
+                "; path tracing (max length {max_length} segments, Russian roulette after {}, \
+                 light and BSDF sampling with MIS)",
+                Integrator::ROULETTE_AFTER
+            )?,
+        }
         if self.camera_rays_only() {
             write!(f, "; camera rays only (first-hit loop)")?;
         }
@@ -299,9 +335,19 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Renderer<'a, S, F> {
         let index = y.wrapping_mul(self.settings.width).wrapping_add(x);
         let spp = self.settings.spp;
         let mut sum = Vec3::ZERO;
-        for k in 0..spp {
-            let mut stream = self.sampler.stream(index, k);
-            sum += integrator::sample_radiance(self, x, y, &mut stream, stats);
+        match self.plan.integrator {
+            Integrator::Direct => {
+                for k in 0..spp {
+                    let mut stream = self.sampler.stream(index, k);
+                    sum += integrator::sample_radiance(self, x, y, &mut stream, stats);
+                }
+            }
+            Integrator::Path { max_length } => {
+                for k in 0..spp {
+                    let mut stream = self.sampler.stream(index, k);
+                    sum += path::sample_radiance(self, x, y, max_length, &mut stream, stats);
+                }
+            }
         }
         // One sample: the mean is the sample (x / 1 is x, bit for bit).
         if spp == 1 {
@@ -431,6 +477,9 @@ fn check_settings(s: &Settings) -> Result<(), SceneError> {
             max: u32::MAX as f32,
         };
         return err("height", p);
+    }
+    if let Integrator::Path { max_length: 0 } = s.integrator {
+        return err("max_length", Problem::NotPositive);
     }
     Ok(())
 }

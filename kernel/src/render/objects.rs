@@ -116,6 +116,8 @@ pub(crate) struct ObjectGeom<'a, S: Scalar, F: AccelFamily<S>> {
     pub(super) base: u32,
     /// Material index (checked).
     pub(crate) material: u32,
+    /// Emitted radiance (checked).
+    pub(crate) emission: super::scene::Rgb,
     /// Motion over the shutter, `None` when static.
     pub(super) motion: Option<[f32; 3]>,
     /// World box over the whole shutter interval (for a static object, its primitives' box).

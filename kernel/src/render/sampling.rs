@@ -308,6 +308,32 @@ pub fn uniform_cone(u: f32, v: f32, cos_max: f32) -> Vec3 {
     Vec3::new(sin_t * libm::cosf(phi), sin_t * libm::sinf(phi), cos_t)
 }
 
+/// The power heuristic (Veach 1997, exponent 2) for one sample of a strategy of density `a`
+/// against another of density `b`: `a² / (a² + b²)`, evaluated without overflow (as
+/// `1 / (1 + (b/a)²)` or `r² / (1 + r²)` with `r = a/b ≤ 1`). `f(a, b) + f(b, a)` is 1 up to
+/// rounding; a density that is not positive (or NaN) gets weight 0, the other then 1; equal
+/// densities (also both infinite) split evenly.
+#[must_use]
+pub fn power_heuristic(a: f32, b: f32) -> f32 {
+    if a <= 0.0 || a.is_nan() {
+        return 0.0;
+    }
+    if b <= 0.0 || b.is_nan() {
+        return 1.0;
+    }
+    if a == b {
+        return 0.5;
+    }
+    if a > b {
+        let r = b / a;
+        1.0 / (1.0 + r * r)
+    } else {
+        let r = a / b;
+        let r2 = r * r;
+        r2 / (1.0 + r2)
+    }
+}
+
 /// An orthonormal basis `(t, b)` completing the unit vector `n` (Duff et al. 2017, branch on
 /// the sign of `n.z`; `copysign` written as an explicit comparison).
 #[must_use]

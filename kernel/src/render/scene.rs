@@ -18,7 +18,8 @@ pub type Rgb = [f32; 3];
 /// How a surface scatters or emits light.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Material {
-    /// Lambertian: lit directly by every light (no diffuse interreflection, as in Cook et al.).
+    /// Lambertian. The direct integrator lights it by the lights alone (no interreflection, as
+    /// in Cook et al.); the path integrator also by every other surface.
     Diffuse {
         /// Reflectance per channel, in `[0, 1]`.
         albedo: Rgb,
@@ -38,7 +39,8 @@ pub enum Material {
         exponent: f32,
     },
     /// Emits `radiance` from both sides and reflects nothing. Seen by camera and reflection
-    /// rays; not sampled as a light (use a [`Light`] for that).
+    /// rays; not sampled as a light (use a [`Light`] for that). A surface that both emits and
+    /// reflects is any other material with [`Object::emission`].
     Emissive {
         /// Emitted radiance per channel, `>= 0`.
         radiance: Rgb,
@@ -88,6 +90,10 @@ pub struct Object<'a, S: Scalar> {
     /// Displacement from shutter open to shutter close (linear motion); zero for a static
     /// object. At shutter time `s ∈ [0, 1)` the object sits at its position plus `s·motion`.
     pub motion: [f32; 3],
+    /// Radiance every surface of the object emits from both sides, per channel `>= 0`, on top
+    /// of what its material reflects. Seen by camera and reflection rays (not sampled as a
+    /// light: use a [`Light`] for that). Zero for most objects.
+    pub emission: Rgb,
 }
 
 impl<'a, S: Scalar> Object<'a, S> {
@@ -98,6 +104,7 @@ impl<'a, S: Scalar> Object<'a, S> {
             shape,
             material,
             motion: [0.0; 3],
+            emission: [0.0; 3],
         }
     }
     /// True if the object moves during the shutter interval.
@@ -188,6 +195,42 @@ impl Filter {
     }
 }
 
+/// The light transport a render computes.
+///
+/// Path length counts segments, camera ray included (the convention of Mitsuba's `max_depth`;
+/// pbrt's `maxdepth` counts bounces, one fewer): length 1 sees emitters, 2 adds direct light,
+/// each more adds one bounce of indirect light. [`Settings::max_depth`] is the direct
+/// integrator's limit on mirror and glossy bounces only; the path integrator ignores it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Integrator {
+    /// Distribution ray tracing: camera rays, mirror and glossy reflections up to
+    /// [`Settings::max_depth`], and at the first diffuse surface the lights' direct light.
+    #[default]
+    Direct,
+    /// Path tracing: diffuse, glossy and mirror bounces; at every non-mirror vertex each light
+    /// is sampled (next-event estimation) and the BSDF is sampled, the two combined by multiple
+    /// importance sampling (power heuristic); Russian roulette once a path has
+    /// [`Integrator::ROULETTE_AFTER`] segments.
+    Path {
+        /// Most segments of a path (`>= 1`).
+        max_length: u32,
+    },
+}
+
+impl Integrator {
+    /// Segments a path has before Russian roulette may end it.
+    pub const ROULETTE_AFTER: u32 = 3;
+
+    /// Lower-case name as used on command lines and in scene files.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Direct => "direct",
+            Self::Path { .. } => "path",
+        }
+    }
+}
+
 /// Image and sampling settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Settings {
@@ -197,8 +240,10 @@ pub struct Settings {
     pub height: u32,
     /// Samples per pixel (`>= 1`); 1 samples the pixel centre.
     pub spp: u32,
-    /// Most reflection bounces after the camera ray.
+    /// Most mirror and glossy bounces after the camera ray ([`Integrator::Direct`] only).
     pub max_depth: u32,
+    /// Light transport.
+    pub integrator: Integrator,
     /// Sample placement.
     pub sampler: SamplerKind,
     /// Pixel filter.
@@ -214,6 +259,7 @@ impl Default for Settings {
             height: 64,
             spp: 16,
             max_depth: 4,
+            integrator: Integrator::Direct,
             sampler: SamplerKind::Stratified,
             filter: Filter::Box,
             seed: 0,

@@ -4,7 +4,8 @@
 
 use super::sampling::SamplerKind;
 use super::scene::{
-    Camera, Filter, Item, Light, Material, Object, Problem, Rgb, Scene, SceneError, Settings, Shape,
+    Camera, Filter, Integrator, Item, Light, Material, Object, Problem, Rgb, Scene, SceneError,
+    Settings, Shape,
 };
 use crate::geom::{Sphere, Triangle};
 use crate::scalar::Scalar;
@@ -46,6 +47,8 @@ pub struct ObjectData {
     pub material: u32,
     /// Displacement over the shutter interval (zero: static).
     pub motion: [f32; 3],
+    /// Emitted radiance ([`Object::emission`]).
+    pub emission: Rgb,
 }
 
 /// A whole scene as `f32` data, with the settings it is meant to be rendered with.
@@ -201,6 +204,7 @@ impl<'d> SceneData<'d> {
                 shape,
                 material: o.material,
                 motion: o.motion,
+                emission: o.emission,
             };
         }
         let n = self.objects.len();
@@ -232,6 +236,7 @@ const fn still(shape: ShapeRange, material: u32) -> ObjectData {
         shape,
         material,
         motion: [0.0; 3],
+        emission: [0.0; 3],
     }
 }
 
@@ -395,6 +400,7 @@ const CORNELL_OBJECTS: [ObjectData; 8] = [
         shape: spheres(2, 1),
         material: 5,
         motion: [0.3, 0.0, 0.0],
+        emission: [0.0; 3],
     },
     // Empty objects are allowed (and cost nothing).
     still(tris(20, 0), 0),
@@ -431,6 +437,7 @@ pub const CORNELL: SceneData<'static> = SceneData {
         height: 64,
         spp: 8,
         max_depth: 4,
+        integrator: Integrator::Direct,
         sampler: SamplerKind::Stratified,
         filter: Filter::Box,
         seed: 1,
@@ -517,6 +524,7 @@ pub const SPHERES: SceneData<'static> = SceneData {
         height: 48,
         spp: 4,
         max_depth: 3,
+        integrator: Integrator::Direct,
         sampler: SamplerKind::Sobol,
         filter: Filter::Tent,
         seed: 7,
@@ -599,11 +607,13 @@ const MOTION_OBJECTS: [ObjectData; 4] = [
         shape: tris(2, 10),
         material: 1,
         motion: [0.0, 0.0, 0.5],
+        emission: [0.0; 3],
     },
     ObjectData {
         shape: spheres(0, 1),
         material: 2,
         motion: [0.0, 0.4, 0.0],
+        emission: [0.0; 3],
     },
     still(spheres(1, 1), 3),
 ];
@@ -643,6 +653,7 @@ pub const MOTION: SceneData<'static> = SceneData {
         height: 48,
         spp: 6,
         max_depth: 2,
+        integrator: Integrator::Direct,
         sampler: SamplerKind::Independent,
         filter: Filter::Box,
         seed: 3,

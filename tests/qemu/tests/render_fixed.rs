@@ -40,6 +40,10 @@ mod tests {
     fn golden_render_motion_fixed() {
         check_render_golden::<I16F16>("render_motion_fixed", &scenes::MOTION)
     }
+    #[test]
+    fn golden_render_cornell_path_fixed() {
+        check_render_golden::<I16F16>("render_cornell_path_fixed", &cases::CORNELL_PATH)
+    }
     /// Stack used by a whole render (scene conversion, per-object BVH builds, renderer, one
     /// row of pixels) of the default scene, printed for the footprint table.
     #[test]
