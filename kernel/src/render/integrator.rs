@@ -32,19 +32,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
     stats: &mut RenderStats,
 ) -> Vec3 {
     let plan: &RenderPlan = &r.plan;
-    let (px, py) = if plan.pixel_centre {
-        (0.5, 0.5)
-    } else {
-        let (a, b) = stream.next_2d();
-        match plan.filter {
-            Filter::Box => (a, b),
-            Filter::Tent => (0.5 + tent(a), 0.5 + tent(b)),
-        }
-    };
-    let lens = plan.lens.then(|| stream.next_2d());
-    let time = if plan.motion { stream.next_2d().0 } else { 0.0 };
-    let (o, d) = r.camera.ray(x as f32 + px, y as f32 + py, lens);
-    stats.camera_rays += 1;
+    let (o, d, time) = camera_sample(r, x, y, stream, stats);
     // The path's current ray, read in place (`&current`): copying a just-built ray out of its
     // `Result` stalls on store forwarding, a measurable share of a primary-only render.
     let mut current = Ray::<S>::from_f32(o.to_array(), d.to_array(), 0.0, f32::INFINITY);
@@ -129,6 +117,34 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
         current = Ray::<S>::new(S::array_to_vec(origin), dir_in_mode::<S>(dir.to_array()));
     }
     radiance
+}
+
+/// The camera ray of one pixel sample, origin and direction (not normalised), and its time:
+/// the pixel position, lens and time drawn from `stream` in that order, as far as the plan uses
+/// them. Both integrators start their paths here.
+#[inline(always)]
+pub(crate) fn camera_sample<S: SpawnScalar, F: AccelFamily<S>>(
+    r: &Renderer<'_, S, F>,
+    x: u32,
+    y: u32,
+    stream: &mut SampleStream,
+    stats: &mut RenderStats,
+) -> (Vec3, Vec3, f32) {
+    let plan: &RenderPlan = &r.plan;
+    let (px, py) = if plan.pixel_centre {
+        (0.5, 0.5)
+    } else {
+        let (a, b) = stream.next_2d();
+        match plan.filter {
+            Filter::Box => (a, b),
+            Filter::Tent => (0.5 + tent(a), 0.5 + tent(b)),
+        }
+    };
+    let lens = plan.lens.then(|| stream.next_2d());
+    let time = if plan.motion { stream.next_2d().0 } else { 0.0 };
+    let (o, d) = r.camera.ray(x as f32 + px, y as f32 + py, lens);
+    stats.camera_rays += 1;
+    (o, d, time)
 }
 
 /// Radiance of pixel `(x, y)` when the plan needs only what camera rays see

@@ -16,10 +16,10 @@
 //! survival probability).
 
 use super::geometry::Surface;
-use super::integrator::{emission_of, light_seen, material_of, reflect};
+use super::integrator::{camera_sample, emission_of, light_seen, material_of, reflect};
 use super::lighting::{light_pdf, light_sum, phong_density, Lobe};
-use super::sampling::{cosine_hemisphere, phong_lobe, tent, to_world, SampleStream};
-use super::scene::{Filter, Integrator, Material};
+use super::sampling::{cosine_hemisphere, phong_lobe, to_world, SampleStream};
+use super::scene::{Integrator, Material};
 use super::surface::dir_in_mode;
 use super::{RenderStats, Renderer};
 use crate::accel::{AccelFamily, NoStats};
@@ -56,19 +56,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
     stats: &mut RenderStats,
 ) -> Vec3 {
     let plan = &r.plan;
-    let (px, py) = if plan.pixel_centre {
-        (0.5, 0.5)
-    } else {
-        let (a, b) = stream.next_2d();
-        match plan.filter {
-            Filter::Box => (a, b),
-            Filter::Tent => (0.5 + tent(a), 0.5 + tent(b)),
-        }
-    };
-    let lens = plan.lens.then(|| stream.next_2d());
-    let time = if plan.motion { stream.next_2d().0 } else { 0.0 };
-    let (o, d) = r.camera.ray(x as f32 + px, y as f32 + py, lens);
-    stats.camera_rays += 1;
+    let (o, d, time) = camera_sample(r, x, y, stream, stats);
     let mut current = Ray::<S>::from_f32(o.to_array(), d.to_array(), 0.0, f32::INFINITY);
     let mut dir = d.normalize_or_zero();
     let mut throughput = Vec3::ONE;
