@@ -340,6 +340,15 @@ fn diffuse_cornell<S: SpawnScalar, R>(f: impl FnOnce(&Scene<'_, S>, Settings) ->
         materials: &materials,
         ..d
     };
+    with_scene(&data, f)
+}
+
+/// The kernel's scene for `data` in mode `S` (primitives converted, objects filled), handed
+/// to `f` with the data's settings.
+fn with_scene<S: SpawnScalar, R>(
+    data: &SceneData<'_>,
+    f: impl FnOnce(&Scene<'_, S>, Settings) -> R,
+) -> R {
     let mut tris = vec![
         Triangle::<S> {
             v: [[S::ZERO; 3]; 3]
@@ -400,34 +409,24 @@ fn direct_integrator_is_the_path_integrator_of_length_two() {
 /// Any tiling gives the same bits: every random value (Russian roulette's too) depends only
 /// on the pixel, the sample and the dimension.
 fn tiles_case<S: SpawnScalar>() {
-    let d = scenes::CORNELL;
-    let mut tris = vec![
-        Triangle::<S> {
-            v: [[S::ZERO; 3]; 3]
+    with_scene::<S, _>(&scenes::CORNELL, |scene, st| {
+        let st = Settings {
+            width: 20,
+            height: 20,
+            spp: 4,
+            integrator: Integrator::Path { max_length: 8 },
+            ..st
         };
-        d.triangles.len()
-    ];
-    let mut spheres = vec![sphere::<S>([0.0; 3], 1.0); d.spheres.len()];
-    d.triangles_into(&mut tris).unwrap();
-    d.spheres_into(&mut spheres).unwrap();
-    let mut objects = vec![Object::new(Shape::Triangles(&[]), 0); d.objects.len()];
-    let scene = d.scene(&tris, &spheres, &mut objects).unwrap();
-    let st = Settings {
-        width: 20,
-        height: 20,
-        spp: 4,
-        integrator: Integrator::Path { max_length: 8 },
-        ..d.settings
-    };
-    let whole = render_tiled(&scene, st, 20).unwrap();
-    for tile in [1, 3, 7] {
-        let tiled = render_tiled(&scene, st, tile).unwrap();
-        let same = whole
-            .iter()
-            .zip(&tiled)
-            .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits));
-        assert!(same, "{} tile {tile}", S::NAME);
-    }
+        let whole = render_tiled(scene, st, 20).unwrap();
+        for tile in [1, 3, 7] {
+            let tiled = render_tiled(scene, st, tile).unwrap();
+            let same = whole
+                .iter()
+                .zip(&tiled)
+                .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits));
+            assert!(same, "{} tile {tile}", S::NAME);
+        }
+    });
 }
 
 #[test]
@@ -490,42 +489,37 @@ fn plan_records_the_integrator_and_checks_the_length() {
 /// (what stays black there is the open front of the box reflected in the spheres).
 #[test]
 fn the_default_scene_ceiling_is_lit_under_the_path_integrator() {
-    let d = scenes::CORNELL;
-    let mut tris = vec![Triangle::<f32> { v: [[0.0; 3]; 3] }; d.triangles.len()];
-    let mut spheres = vec![sphere::<f32>([0.0; 3], 1.0); d.spheres.len()];
-    d.triangles_into(&mut tris).unwrap();
-    d.spheres_into(&mut spheres).unwrap();
-    let mut objects = vec![Object::new(Shape::Triangles(&[]), 0); d.objects.len()];
-    let scene = d.scene(&tris, &spheres, &mut objects).unwrap();
-    let (w, h) = (48usize, 48usize);
-    let st = Settings {
-        width: w as u32,
-        height: h as u32,
-        spp: 8,
-        ..d.settings
-    };
-    let direct = render(&scene, st);
-    let path = render(
-        &scene,
-        Settings {
-            integrator: Integrator::Path { max_length: 5 },
-            ..st
-        },
-    );
-    let black = |p: &[f32; 3]| *p == [0.0; 3];
-    // The top sixth of the image is ceiling between the side walls.
-    let ceiling: Vec<usize> = (0..w * h / 6).filter(|&i| black(&direct[i])).collect();
-    assert!(
-        ceiling.len() > w * h / 6 / 2,
-        "direct: {} black ceiling pixels",
-        ceiling.len()
-    );
-    let unlit = ceiling.iter().filter(|&&i| black(&path[i])).count();
-    assert_eq!(unlit, 0, "path: ceiling pixels still black");
-    let count = |px: &[[f32; 3]]| px.iter().filter(|p| black(p)).count();
-    let (d_black, p_black) = (count(&direct), count(&path));
-    assert!(
-        4 * p_black < d_black,
-        "black pixels: direct {d_black}, path {p_black}"
-    );
+    with_scene::<f32, _>(&scenes::CORNELL, |scene, settings| {
+        let (w, h) = (48usize, 48usize);
+        let st = Settings {
+            width: w as u32,
+            height: h as u32,
+            spp: 8,
+            ..settings
+        };
+        let direct = render(scene, st);
+        let path = render(
+            scene,
+            Settings {
+                integrator: Integrator::Path { max_length: 5 },
+                ..st
+            },
+        );
+        let black = |p: &[f32; 3]| *p == [0.0; 3];
+        // The top sixth of the image is ceiling between the side walls.
+        let ceiling: Vec<usize> = (0..w * h / 6).filter(|&i| black(&direct[i])).collect();
+        assert!(
+            ceiling.len() > w * h / 6 / 2,
+            "direct: {} black ceiling pixels",
+            ceiling.len()
+        );
+        let unlit = ceiling.iter().filter(|&&i| black(&path[i])).count();
+        assert_eq!(unlit, 0, "path: ceiling pixels still black");
+        let count = |px: &[[f32; 3]]| px.iter().filter(|p| black(p)).count();
+        let (d_black, p_black) = (count(&direct), count(&path));
+        assert!(
+            4 * p_black < d_black,
+            "black pixels: direct {d_black}, path {p_black}"
+        );
+    });
 }
