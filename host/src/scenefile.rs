@@ -39,7 +39,7 @@ pub const DEFAULT_SETTINGS: Settings = Settings {
     spp: 64,
     max_depth: 4,
     integrator: Integrator::Direct,
-    sampler: SamplerKind::Stratified,
+    sampler: SamplerKind::Sobol,
     filter: Filter::Box,
     seed: 0,
 };
