@@ -198,6 +198,10 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
         Some(opts) => images::run(opts)?,
         None => Vec::new(),
     };
+    let firefly_rows = match &config.images {
+        Some(opts) => images::fireflies(config.quick, opts.threads)?,
+        None => Vec::new(),
+    };
     let gi_results = config.gi.as_ref().map(gi::run).transpose()?;
     machine.finish();
     let mut results = BenchResults {
@@ -230,6 +234,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
         refit: refit_rows,
         images: image_rows,
         gi: gi_results,
+        fireflies: firefly_rows,
         overhead: overhead_rows,
         objects: objects_rows,
         slopes: Vec::new(),
