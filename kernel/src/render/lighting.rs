@@ -23,7 +23,8 @@ pub(super) enum Lobe {
     Diffuse,
     /// The normalised Phong lobe around the unit mirror direction: the weight is the lobe's
     /// density `(n+1)/(2π)·cos^n α` (the BSDF times `cos θ`, over the reflectance), which is
-    /// also BSDF sampling's density.
+    /// also BSDF sampling's density. Shaded by the path integrator alone.
+    #[cfg_attr(not(feature = "path-tracing"), allow(dead_code))]
     Glossy {
         /// Unit mirror direction.
         mirror: Vec3,
@@ -173,6 +174,7 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
 /// The solid-angle density with which [`light_sum`] samples the unit direction `dir` from
 /// `from` towards light `i`, whose surface a ray along `dir` hit (0 where it samples nothing:
 /// point lights, a rectangle's back, the inside of a sphere light).
+#[cfg_attr(not(feature = "path-tracing"), allow(dead_code))]
 pub(super) fn light_pdf<S: SpawnScalar, F: AccelFamily<S>>(
     lights: &[Light],
     geometry: &Geometry<'_, S, F>,

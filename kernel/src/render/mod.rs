@@ -24,6 +24,7 @@ mod lights;
 mod memory;
 mod motion;
 mod objects;
+#[cfg(feature = "path-tracing")]
 mod path;
 pub mod sampling;
 mod scene;
@@ -342,12 +343,16 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Renderer<'a, S, F> {
                     sum += integrator::sample_radiance(self, x, y, &mut stream, stats);
                 }
             }
+            #[cfg(feature = "path-tracing")]
             Integrator::Path { max_length } => {
                 for k in 0..spp {
                     let mut stream = self.sampler.stream(index, k);
                     sum += path::sample_radiance(self, x, y, max_length, &mut stream, stats);
                 }
             }
+            // Rejected by `Renderer::new` (`check_settings`).
+            #[cfg(not(feature = "path-tracing"))]
+            Integrator::Path { .. } => {}
         }
         // One sample: the mean is the sample (x / 1 is x, bit for bit).
         if spp == 1 {
@@ -478,8 +483,13 @@ fn check_settings(s: &Settings) -> Result<(), SceneError> {
         };
         return err("height", p);
     }
-    if let Integrator::Path { max_length: 0 } = s.integrator {
-        return err("max_length", Problem::NotPositive);
+    if let Integrator::Path { max_length } = s.integrator {
+        if !cfg!(feature = "path-tracing") {
+            return err("integrator", Problem::NotLinked);
+        }
+        if max_length == 0 {
+            return err("max_length", Problem::NotPositive);
+        }
     }
     Ok(())
 }

@@ -211,6 +211,11 @@ pub enum Integrator {
     /// is sampled (next-event estimation) and the BSDF is sampled, the two combined by multiple
     /// importance sampling (power heuristic); Russian roulette once a path has
     /// [`Integrator::ROULETTE_AFTER`] segments.
+    ///
+    /// Linked only with the kernel's `path-tracing` feature; without it the variant still
+    /// exists (scene files and settings keep one shape) and [`crate::render::Renderer::new`]
+    /// rejects it with a [`SceneError`] on [`Item::Settings`], field `integrator`,
+    /// [`Problem::NotLinked`].
     Path {
         /// Most segments of a path (`>= 1`).
         max_length: u32,
@@ -340,8 +345,9 @@ pub enum Problem {
     },
     /// A primitive could not be built into the accelerator.
     Build(crate::accel::BuildError),
-    /// A kind of primitive this renderer's accelerator family leaves out
-    /// ([`crate::AccelFamily::SPHERES`]).
+    /// A part of the renderer this build leaves out: a kind of primitive the accelerator
+    /// family does not link ([`crate::AccelFamily::SPHERES`]), or [`Integrator::Path`] without
+    /// the kernel's `path-tracing` feature.
     NotLinked,
 }
 
@@ -392,7 +398,7 @@ impl fmt::Display for Problem {
                 write!(f, "buffer too small: need {needed} slots, have {available}")
             }
             Self::Build(e) => write!(f, "{e}"),
-            Self::NotLinked => write!(f, "this renderer is built without this kind of primitive"),
+            Self::NotLinked => write!(f, "this renderer is built without it"),
         }
     }
 }
