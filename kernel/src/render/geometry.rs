@@ -17,7 +17,7 @@ use super::SceneError;
 use crate::accel::bvh::{BuildOptions, Bvh};
 use crate::accel::{take, AccelFamily, BuildError, Counters, MemoryNeeded};
 use crate::geom::spawn::{cross, sub, unit, SpawnScalar};
-use crate::geom::{closer, Aabb, Primitive, Ray};
+use crate::geom::{closer, Aabb, Primitive, Ray, Sphere};
 use crate::scalar::Scalar;
 
 /// What a closest hit found.
@@ -114,6 +114,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
                 base,
                 material: o.material,
                 emission: o.emission,
+                one_sided: o.one_sided,
                 motion,
                 swept,
             };
@@ -328,11 +329,9 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
                 let p: [f64; 3] = core::array::from_fn(|k| {
                     v[0][k] + u * (v[1][k] - v[0][k]) + w * (v[2][k] - v[0][k]) + d[k]
                 });
-                let n = unit(cross(&sub(&v[1], &v[0]), &sub(&v[2], &v[0])))
-                    .unwrap_or_else(|| S::ray_dir(ray.data()).map(|x| -x.to_f64()));
                 Some(SurfacePoint {
                     position: p,
-                    normal: n.map(|x| x as f32),
+                    normal: triangle_normal(&v, ray),
                     prim: Prim::Triangle(tri, hu, hv),
                     shift: d,
                 })
@@ -340,12 +339,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
             Shape::Spheres(s) if F::SPHERES => {
                 let sp = s.get(local as usize)?;
                 let c = sp.center.map(S::to_f64);
-                // The hit point from the ray in the object's frame, then shifted back.
-                let o3 = S::vec_to_array(ray.origin()).map(S::to_f64);
-                let dir = S::ray_dir(ray.data()).map(S::to_f64);
-                let t = h.t.to_f64();
-                let q: [f64; 3] = core::array::from_fn(|k| o3[k] - d[k] + t * dir[k]);
-                let n = unit(sub(&q, &c)).unwrap_or(dir.map(|x| -x));
+                let n = sphere_normal(sp, ray, h.t, d);
                 let r = sp.radius.to_f64();
                 // The point on the sphere along the normal: the offset is taken from there.
                 let p: [f64; 3] = core::array::from_fn(|k| c[k] + r * n[k] + d[k]);
@@ -359,6 +353,48 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
             Shape::Spheres(_) => None,
         }
     }
+}
+
+impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
+    /// The unit geometric normal [`Geometry::surface_point`] gives for hit `h`, without the
+    /// rest of the surface point (no barycentrics). `None` for lights.
+    pub(crate) fn normal_at(&self, ray: &Ray<S>, h: &SceneHit<S>, time: f32) -> Option<[f32; 3]> {
+        let Surface::Object { object, local } = h.surface else {
+            return None;
+        };
+        let o = self.object(object)?;
+        match o.shape {
+            // A translation does not turn a triangle: no motion needed.
+            Shape::Triangles(t) => {
+                let v = t.get(local as usize)?.v.map(|p| p.map(S::to_f64));
+                Some(triangle_normal(&v, ray))
+            }
+            Shape::Spheres(s) if F::SPHERES => {
+                let d = o.motion.map_or([0.0; 3], |m| displacement::<S>(m, time));
+                let n = sphere_normal(s.get(local as usize)?, ray, h.t, d);
+                Some(n.map(|x| x as f32))
+            }
+            Shape::Spheres(_) => None,
+        }
+    }
+}
+
+/// A triangle's unit geometric normal `(v1 − v0) × (v2 − v0)` (degenerate: against the ray).
+fn triangle_normal<S: SpawnScalar>(v: &[[f64; 3]; 3], ray: &Ray<S>) -> [f32; 3] {
+    unit(cross(&sub(&v[1], &v[0]), &sub(&v[2], &v[0])))
+        .unwrap_or_else(|| S::ray_dir(ray.data()).map(|x| -x.to_f64()))
+        .map(|x| x as f32)
+}
+
+/// A sphere's unit outward normal at the ray's hit `t`, the sphere displaced by `d` (the hit
+/// point from the ray in the sphere's frame; at the centre: against the ray).
+fn sphere_normal<S: SpawnScalar>(sp: &Sphere<S>, ray: &Ray<S>, t: S, d: [f64; 3]) -> [f64; 3] {
+    let c = sp.center.map(S::to_f64);
+    let o3 = S::vec_to_array(ray.origin()).map(S::to_f64);
+    let dir = S::ray_dir(ray.data()).map(S::to_f64);
+    let t = t.to_f64();
+    let q: [f64; 3] = core::array::from_fn(|k| o3[k] - d[k] + t * dir[k]);
+    unit(sub(&q, &c)).unwrap_or(dir.map(|x| -x))
 }
 
 fn union_bounds<S: Scalar, P: Primitive<S>>(prims: &[P]) -> Option<Aabb<S>> {

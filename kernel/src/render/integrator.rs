@@ -3,7 +3,7 @@
 //! what the render plan says the scene needs. Also the camera-ray-only loop and the helpers
 //! the path integrator ([`super::path`]) shares.
 
-use super::geometry::Surface;
+use super::geometry::{SceneHit, Surface};
 use super::lighting::{light_sum, Lobe};
 use super::sampling::{phong_lobe, tent, to_world, SampleStream};
 use super::scene::{Filter, Light, Material};
@@ -55,6 +55,9 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
             }
             Surface::Object { object, .. } => object,
         };
+        if plan.one_sided && behind_one_sided(r, ray, &hit, time, object, unit_at(dir, depth)) {
+            break;
+        }
         if plan.emitting_objects {
             radiance += throughput * emission_of(r, object);
         }
@@ -173,6 +176,12 @@ pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>>(
         Some(hit) => match hit.surface {
             Surface::Light { light } => light_seen(r, light, d.normalize_or_zero()),
             Surface::Object { object, .. } => match material_of(r, object) {
+                Some(Material::Emissive { .. })
+                    if r.plan.one_sided
+                        && behind_one_sided(r, ray, &hit, 0.0, object, d.normalize_or_zero()) =>
+                {
+                    return Vec3::ZERO
+                }
                 Some(Material::Emissive { radiance }) => Vec3::from_array(*radiance),
                 _ => return Vec3::ZERO,
             },
@@ -191,6 +200,24 @@ pub(super) fn material_of<'r, S: SpawnScalar, F: AccelFamily<S>>(
     r.geometry
         .object(object)
         .and_then(|o| r.materials.get(o.material as usize))
+}
+
+/// True if hit `hit` of `ray` (unit direction `dir`) lies on the back of object `object` and
+/// the object is one-sided ([`super::Object::one_sided`]): the back is black and ends the path.
+/// The side is the one shading sees: the sign of `dir` against the surface point's normal.
+#[inline]
+pub(super) fn behind_one_sided<S: SpawnScalar, F: AccelFamily<S>>(
+    r: &Renderer<'_, S, F>,
+    ray: &Ray<S>,
+    hit: &SceneHit<S>,
+    time: f32,
+    object: usize,
+    dir: Vec3,
+) -> bool {
+    r.geometry.object(object).is_some_and(|o| o.one_sided)
+        && r.geometry
+            .normal_at(ray, hit, time)
+            .is_some_and(|n| Vec3::from_array(n).dot(dir) > 0.0)
 }
 
 /// Radiance object `object` emits ([`super::Object::emission`]; zero for an index the

@@ -76,6 +76,9 @@ pub struct RenderPlan {
     pub integrator: Integrator,
     /// Some object emits ([`Object::emission`]): hits add its radiance.
     pub emitting_objects: bool,
+    /// Some object is [`Object::one_sided`]: hits on a surface's back are checked (black, the
+    /// path ends).
+    pub one_sided: bool,
     /// Some radiance is found only by rays that hit it, not by sampling the lights: a
     /// background that is not black, an emissive material or an emitting object. Without it
     /// the path integrator ends a path at its last vertex once the lights are sampled.
@@ -131,6 +134,7 @@ impl RenderPlan {
             area_lights: count(true),
             integrator: settings.integrator,
             emitting_objects,
+            one_sided: scene.objects.iter().any(|o| o.one_sided),
             unsampled_emission: emitting_objects
                 || scene.background != [0.0; 3]
                 || used(|m| matches!(m, Material::Emissive { .. })),
@@ -166,6 +170,9 @@ impl fmt::Display for RenderPlan {
         )?;
         if self.emitting_objects {
             write!(f, "; emitting objects")?;
+        }
+        if self.one_sided {
+            write!(f, "; one-sided surfaces")?;
         }
         match self.integrator {
             Integrator::Direct => write!(

@@ -118,6 +118,8 @@ pub(crate) struct ObjectGeom<'a, S: Scalar, F: AccelFamily<S>> {
     pub(crate) material: u32,
     /// Emitted radiance (checked).
     pub(crate) emission: super::scene::Rgb,
+    /// Reflects and emits on the front only ([`super::Object::one_sided`]).
+    pub(crate) one_sided: bool,
     /// Motion over the shutter, `None` when static.
     pub(super) motion: Option<[f32; 3]>,
     /// World box over the whole shutter interval (for a static object, its primitives' box).

@@ -16,7 +16,9 @@
 //! survival probability).
 
 use super::geometry::Surface;
-use super::integrator::{camera_sample, emission_of, light_seen, material_of, reflect};
+use super::integrator::{
+    behind_one_sided, camera_sample, emission_of, light_seen, material_of, reflect,
+};
 use super::lighting::{light_pdf, light_sum, phong_density, Lobe};
 use super::sampling::{cosine_hemisphere, phong_lobe, to_world, SampleStream};
 use super::scene::{Integrator, Material};
@@ -86,6 +88,9 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
             }
             Surface::Object { object, .. } => object,
         };
+        if plan.one_sided && behind_one_sided(r, ray, &hit, time, object, dir) {
+            break;
+        }
         if plan.emitting_objects {
             radiance += throughput * emission_of(r, object);
         }

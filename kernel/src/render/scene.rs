@@ -38,7 +38,8 @@ pub enum Material {
         /// Lobe exponent `n >= 1`: larger is sharper.
         exponent: f32,
     },
-    /// Emits `radiance` from both sides and reflects nothing. Seen by camera and reflection
+    /// Emits `radiance` (from both sides unless the object is [`Object::one_sided`]) and
+    /// reflects nothing. Seen by camera and reflection
     /// rays; not sampled as a light (use a [`Light`] for that). A surface that both emits and
     /// reflects is any other material with [`Object::emission`].
     Emissive {
@@ -90,10 +91,16 @@ pub struct Object<'a, S: Scalar> {
     /// Displacement from shutter open to shutter close (linear motion); zero for a static
     /// object. At shutter time `s ∈ [0, 1)` the object sits at its position plus `s·motion`.
     pub motion: [f32; 3],
-    /// Radiance every surface of the object emits from both sides, per channel `>= 0`, on top
-    /// of what its material reflects. Seen by camera and reflection rays (not sampled as a
-    /// light: use a [`Light`] for that). Zero for most objects.
+    /// Radiance every surface of the object emits, per channel `>= 0`, on top of what its
+    /// material reflects; from both sides unless [`Object::one_sided`]. Seen by camera and
+    /// reflection rays. Zero for most objects.
     pub emission: Rgb,
+    /// One-sided: the object reflects and emits only on the front of its surfaces, the side
+    /// the geometric normal points to (a triangle's `(v1 − v0) × (v2 − v0)`: its vertices run
+    /// counter-clockwise seen from the front; a sphere's outside). Seen from behind it is
+    /// black, and it blocks light from both sides. `false` (two-sided, the default): both
+    /// sides reflect and emit alike.
+    pub one_sided: bool,
 }
 
 impl<'a, S: Scalar> Object<'a, S> {
@@ -105,6 +112,7 @@ impl<'a, S: Scalar> Object<'a, S> {
             material,
             motion: [0.0; 3],
             emission: [0.0; 3],
+            one_sided: false,
         }
     }
     /// True if the object moves during the shutter interval.
