@@ -11,7 +11,7 @@ use super::lights::{light_geom, LightGeom, MAX_LIGHTS};
 use super::memory::{memory_needed, RenderMemory};
 use super::motion::{displacement, moved_into_frame, swept_box};
 use super::objects::{ObjectGeom, ObjectSlot, ShapeAccel};
-use super::scene::{Item, Light, Object, Problem, Shape};
+use super::scene::{Item, Light, Material, Object, Problem, Shape};
 use super::surface::{Prim, SurfacePoint};
 use super::SceneError;
 use crate::accel::bvh::{BuildOptions, Bvh};
@@ -57,12 +57,16 @@ pub(crate) struct Geometry<'a, S: Scalar, F: AccelFamily<S>> {
     pub(crate) lights: heapless::Vec<LightGeom<S>, MAX_LIGHTS>,
     /// Global id of the first light.
     light_base: u32,
+    /// Emissive primitives: every primitive of every object that emits
+    /// ([`super::emitters`]).
+    pub(crate) emitter_count: u32,
 }
 
 impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     /// Builds every object's accelerator into the caller's memory ([`memory_needed`]).
     pub(crate) fn build(
         objects: &'a [Object<'a, S>],
+        materials: &[Material],
         lights: &[Light],
         options: &F::Options,
         memory: RenderMemory<'a, S, F>,
@@ -90,6 +94,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
         }
         let slots = take(&mut slots, objects.len());
         let mut base = 0u32;
+        let mut emitter_count = 0u32;
         for (i, (o, slot)) in objects.iter().zip(slots.iter_mut()).enumerate() {
             let bad = |e| err(i, "shape", Problem::Build(e));
             if !super::scene::finite3(o.motion) {
@@ -108,6 +113,12 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
                 (_, b) => b.unwrap_or(Aabb::new([S::ZERO; 3], [S::ZERO; 3])),
             };
             let len = u32::try_from(o.shape.len()).unwrap_or(u32::MAX);
+            let emitted = emitted_by(o, materials);
+            let emitter_base = emitter_count;
+            if emitted != [0.0; 3] {
+                // At most the global ids' count, checked below.
+                emitter_count = emitter_count.saturating_add(len);
+            }
             let g = ObjectGeom {
                 accel,
                 shape: o.shape,
@@ -115,6 +126,8 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
                 material: o.material,
                 emission: o.emission,
                 one_sided: o.one_sided,
+                emitted,
+                emitter_base,
                 motion,
                 swept,
             };
@@ -143,6 +156,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
             tlas,
             lights: heapless::Vec::new(),
             light_base: base,
+            emitter_count,
         };
         for (i, l) in lights.iter().enumerate() {
             let _ = geo.lights.push(
@@ -178,6 +192,12 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     pub(crate) fn objects(&self) -> impl Iterator<Item = (usize, &ObjectGeom<'a, S, F>)> {
         let built = self.objects.iter().map(|s| s.0.as_ref());
         built.enumerate().filter_map(|(i, o)| o.map(|o| (i, o)))
+    }
+
+    /// The objects' slots, in scene order (all filled).
+    #[inline]
+    pub(crate) fn slots(&self) -> &'a [ObjectSlot<'a, S, F>] {
+        self.objects
     }
 
     /// Object `i`.
@@ -395,6 +415,26 @@ fn sphere_normal<S: SpawnScalar>(sp: &Sphere<S>, ray: &Ray<S>, t: S, d: [f64; 3]
     let t = t.to_f64();
     let q: [f64; 3] = core::array::from_fn(|k| o3[k] - d[k] + t * dir[k]);
     unit(sub(&q, &c)).unwrap_or(dir.map(|x| -x))
+}
+
+/// What object `o` emits: its emission plus its material's if that is emissive (checked
+/// values: finite, non-negative; a sum past `f32::MAX` saturates).
+pub(super) fn emitted_by<S: Scalar>(
+    o: &Object<'_, S>,
+    materials: &[Material],
+) -> super::scene::Rgb {
+    let e = match materials.get(o.material as usize) {
+        Some(Material::Emissive { radiance }) => *radiance,
+        _ => [0.0; 3],
+    };
+    core::array::from_fn(|k| {
+        let s = o.emission[k] + e[k];
+        if s > f32::MAX {
+            f32::MAX
+        } else {
+            s
+        }
+    })
 }
 
 fn union_bounds<S: Scalar, P: Primitive<S>>(prims: &[P]) -> Option<Aabb<S>> {

@@ -152,9 +152,9 @@ pub(crate) fn camera_sample<S: SpawnScalar, F: AccelFamily<S>>(
 
 /// Radiance of pixel `(x, y)` when the plan needs only what camera rays see
 /// ([`RenderPlan::camera_rays_only`]): one ray through the pixel centre from the renderer's
-/// eye ray, a static scene, no lights to sample and nothing reflecting.
-/// Emitters, light surfaces seen directly and the background are then the whole picture;
-/// other surfaces are black. The same bits as [`sample_radiance`] under that plan (the same
+/// eye ray, a static scene, no lights to sample, no emissive geometry and nothing reflecting.
+/// Light surfaces seen directly and the background are then the whole picture; objects are
+/// black. The same bits as [`sample_radiance`] under that plan (the same
 /// operations in the same order), without its sample stream, path state and bounce loop.
 #[cfg_attr(not(target_os = "none"), inline(always))]
 pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>>(
@@ -175,16 +175,9 @@ pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>>(
         None => Vec3::from_array(r.background),
         Some(hit) => match hit.surface {
             Surface::Light { light } => light_seen(r, light, d.normalize_or_zero()),
-            Surface::Object { object, .. } => match material_of(r, object) {
-                Some(Material::Emissive { .. })
-                    if r.plan.one_sided
-                        && behind_one_sided(r, ray, &hit, 0.0, object, d.normalize_or_zero()) =>
-                {
-                    return Vec3::ZERO
-                }
-                Some(Material::Emissive { radiance }) => Vec3::from_array(*radiance),
-                _ => return Vec3::ZERO,
-            },
+            // Nothing emits under this plan (emissive geometry lights the scene, so it takes
+            // the general loop) and nothing is lit.
+            Surface::Object { .. } => return Vec3::ZERO,
         },
     };
     // As `sample_radiance` adds it: zero radiance plus unit throughput times what is seen.
@@ -230,6 +223,19 @@ pub(super) fn emission_of<S: SpawnScalar, F: AccelFamily<S>>(
     r.geometry
         .object(object)
         .map_or(Vec3::ZERO, |o| Vec3::from_array(o.emission))
+}
+
+/// Radiance object `object` emits as emissive geometry: its emission plus an emissive
+/// material's (zero for an index the renderer's checks rule out).
+#[cfg_attr(not(feature = "path-tracing"), allow(dead_code))]
+#[inline]
+pub(super) fn emitted<S: SpawnScalar, F: AccelFamily<S>>(
+    r: &Renderer<'_, S, F>,
+    object: usize,
+) -> Vec3 {
+    r.geometry
+        .object(object)
+        .map_or(Vec3::ZERO, |o| Vec3::from_array(o.emitted))
 }
 
 /// The path's direction at bounce `depth` as a unit vector: the camera's (depth 0) is

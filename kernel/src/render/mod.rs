@@ -17,6 +17,7 @@
 //! separate dimension pairs of the sample stream ([`sampling`]).
 
 mod camera;
+mod emitters;
 mod geometry;
 mod integrator;
 mod lighting;
@@ -76,6 +77,9 @@ pub struct RenderPlan {
     pub integrator: Integrator,
     /// Some object emits ([`Object::emission`]): hits add its radiance.
     pub emitting_objects: bool,
+    /// Some object emits (its [`Object::emission`] or an emissive material): next-event
+    /// estimation samples its surfaces as area lights.
+    pub emissive_geometry: bool,
     /// Some object is [`Object::one_sided`]: hits on a surface's back are checked (black, the
     /// path ends).
     pub one_sided: bool,
@@ -94,13 +98,13 @@ pub struct RenderPlan {
 
 impl RenderPlan {
     /// True when camera rays are all a render casts: the direct integrator, one sample at each
-    /// pixel centre, a pinhole, nothing moving, no lights, no emitting objects and nothing
-    /// reflecting. The renderer then runs a first-hit loop without sample streams or a bounce
+    /// pixel centre, a pinhole, nothing moving, no lights, no emissive geometry (emitting
+    /// objects or emissive materials) and nothing reflecting. The renderer then runs a first-hit loop without sample streams or a bounce
     /// loop (the same bits).
     #[must_use]
     pub const fn camera_rays_only(&self) -> bool {
         matches!(self.integrator, Integrator::Direct)
-            && !self.emitting_objects
+            && !self.emissive_geometry
             && self.pixel_centre
             && !self.lens
             && !self.motion
@@ -134,6 +138,9 @@ impl RenderPlan {
             area_lights: count(true),
             integrator: settings.integrator,
             emitting_objects,
+            emissive_geometry: scene.objects.iter().any(|o| {
+                !o.shape.is_empty() && geometry::emitted_by(o, scene.materials) != [0.0; 3]
+            }),
             one_sided: scene.objects.iter().any(|o| o.one_sided),
             unsampled_emission: emitting_objects
                 || scene.background != [0.0; 3]
@@ -170,6 +177,9 @@ impl fmt::Display for RenderPlan {
         )?;
         if self.emitting_objects {
             write!(f, "; emitting objects")?;
+        }
+        if self.emissive_geometry {
+            write!(f, "; emissive geometry sampled as lights")?;
         }
         if self.one_sided {
             write!(f, "; one-sided surfaces")?;
@@ -293,7 +303,8 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Renderer<'a, S, F> {
         let camera = CameraFrame::new(&scene.camera, settings.width, settings.height)?;
         scene::check_rgb(scene.background, false)
             .map_err(|p| SceneError::new(Item::Settings, 0, "background", p))?;
-        let geometry = Geometry::build(scene.objects, scene.lights, &accel, memory)?;
+        let geometry =
+            Geometry::build(scene.objects, scene.materials, scene.lights, &accel, memory)?;
         Ok(Self {
             geometry,
             materials: scene.materials,

@@ -39,9 +39,10 @@ pub enum Material {
         exponent: f32,
     },
     /// Emits `radiance` (from both sides unless the object is [`Object::one_sided`]) and
-    /// reflects nothing. Seen by camera and reflection
-    /// rays; not sampled as a light (use a [`Light`] for that). A surface that both emits and
-    /// reflects is any other material with [`Object::emission`].
+    /// reflects nothing. An area light: seen by camera and reflection rays, sampled by
+    /// next-event estimation in both integrators (the direct one lights diffuse surfaces by
+    /// it), casting shadows like any surface. A surface that both emits and reflects is any
+    /// other material with [`Object::emission`].
     Emissive {
         /// Emitted radiance per channel, `>= 0`.
         radiance: Rgb,
@@ -92,8 +93,8 @@ pub struct Object<'a, S: Scalar> {
     /// object. At shutter time `s ∈ [0, 1)` the object sits at its position plus `s·motion`.
     pub motion: [f32; 3],
     /// Radiance every surface of the object emits, per channel `>= 0`, on top of what its
-    /// material reflects; from both sides unless [`Object::one_sided`]. Seen by camera and
-    /// reflection rays. Zero for most objects.
+    /// material reflects; from both sides unless [`Object::one_sided`]. An area light, as an
+    /// emissive material is ([`Material::Emissive`]). Zero for most objects.
     pub emission: Rgb,
     /// One-sided: the object reflects and emits only on the front of its surfaces, the side
     /// the geometric normal points to (a triangle's `(v1 − v0) × (v2 − v0)`: its vertices run
