@@ -207,6 +207,7 @@ impl GiScene {
             material,
             motion: [0.0; 3],
             emission: [0.0; 3],
+            one_sided: false,
         });
     }
 

@@ -325,6 +325,7 @@ pub fn split_by_material(spec: &mut SceneSpec, m: &MeshMaterials) {
             material,
             motion,
             emission: [0.0; 3],
+            one_sided: false,
         });
         first += count;
     }

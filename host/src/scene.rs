@@ -300,6 +300,7 @@ pub fn lit_mesh_scene(
             material: 0,
             motion: [0.0; 3],
             emission: [0.0; 3],
+            one_sided: false,
         }],
         object_sources: vec![source],
         materials: vec![Material::Diffuse { albedo: OBJ_ALBEDO }],

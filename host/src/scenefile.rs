@@ -320,6 +320,16 @@ pub struct ObjectEntry {
     /// none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<[f32; 3]>,
+    /// Reflects and emits on the front of its surfaces only (the side a triangle's
+    /// counter-clockwise winding faces, a sphere's outside); black from behind (default
+    /// `false`: two-sided).
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub one_sided: bool,
+}
+
+#[allow(clippy::trivially_copy_pass_by_ref)] // serde's `skip_serializing_if` passes a reference
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 /// A sphere.
@@ -757,6 +767,7 @@ fn resolve(file: SceneFile, path: &Path, stem: &str) -> Result<SceneSpec, Error>
             material: index_u32(material),
             motion: o.motion.unwrap_or([0.0; 3]),
             emission: o.emission.unwrap_or([0.0; 3]),
+            one_sided: o.one_sided,
         });
         spec.object_sources.push(source);
     }
@@ -937,6 +948,7 @@ pub fn to_scene_file(d: &SceneData<'_>, material_names: &[String]) -> SceneFile 
                 material: name(o.material as usize),
                 motion: (o.motion != [0.0; 3]).then_some(o.motion),
                 emission: (o.emission != [0.0; 3]).then_some(o.emission),
+                one_sided: o.one_sided,
             }
         })
         .collect();

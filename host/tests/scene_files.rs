@@ -794,3 +794,26 @@ fn integrator_and_emission_keys_load_dump_and_render_the_same_bytes() {
     let e = broken(|v| v["objects"][0]["emission"] = json!([-1, 0, 0]));
     assert!(e.contains("emission"), "{e}");
 }
+
+#[test]
+fn one_sided_key_loads_dumps_and_defaults_to_two_sided() {
+    let mut v = base();
+    assert!(!load_value(&v).unwrap().objects[0].one_sided);
+    v["objects"][0]["one_sided"] = json!(true);
+    let spec = load_value(&v).unwrap();
+    assert!(spec.objects[0].one_sided);
+    assert!(!spec.objects[1].one_sided);
+    // A one-sided object round-trips; two-sided ones write no key.
+    let mut objects = scenes::CORNELL.objects.to_vec();
+    objects[0].one_sided = true;
+    let d = SceneData {
+        objects: &objects,
+        ..scenes::CORNELL
+    };
+    let text = dump(&d, &[]);
+    assert_eq!(text.matches("\"one_sided\"").count(), 1, "{text}");
+    let loaded = parse_scene_file(&text, Path::new("cornell.json")).unwrap();
+    assert_eq!(loaded.data(), d);
+    let e = broken(|v| v["objects"][0]["one_sided"] = json!("yes"));
+    assert!(e.contains("one_sided"), "{e}");
+}

@@ -8,6 +8,11 @@
 //! standard error of their mean is `σ̂ / √pixels` with `σ̂` their sample standard deviation.
 //! A test accepts a difference of at most [`Z`] standard errors and asserts that the standard
 //! error itself is small, so a biased estimator cannot hide in noise.
+//!
+//! Needs the kernel's `path-tracing` feature (`cargo test -p raykernel --features
+//! path-tracing`); without it `tests/features.rs` checks the typed error and prints a
+//! `skipped` line for this file.
+#![cfg(feature = "path-tracing")]
 
 use raykernel::render::sampling::power_heuristic;
 use raykernel::render::scenes::{self, SceneData};

@@ -11,7 +11,7 @@ pub use crate::Rng;
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::render::scenes::{self, SceneData};
 use raykernel::render::{
-    Integrator, Object, ObjectSlot, RenderMemory, Renderer, Settings, Shape, Tile,
+    Integrator, Object, ObjectSlot, Problem, RenderMemory, Renderer, Settings, Shape, Tile,
 };
 use raykernel::spawn::SpawnScalar;
 use raykernel::{
@@ -66,6 +66,9 @@ pub enum Fail {
     Invalid,
     /// A query through the BVH differed from brute force on ray `index`.
     Differs { index: usize },
+    /// The case needs a part of the kernel this build leaves out (the path integrator without
+    /// the `path-tracing` feature): it cannot be checked here, which is not a pass.
+    NotLinked,
 }
 
 /// 64-bit FNV-1a over little-endian words.
@@ -384,8 +387,13 @@ pub fn render_hash<S: Bits + SpawnScalar>(data: &SceneData<'_>) -> Result<u64, F
             ..AccelMemory::default()
         },
     };
-    let r =
-        Renderer::new(&scene, data.settings, BuildOptions::default(), memory).map_err(reject)?;
+    let r = Renderer::new(&scene, data.settings, BuildOptions::default(), memory).map_err(|e| {
+        if e.problem == Problem::NotLinked {
+            Fail::NotLinked
+        } else {
+            Fail::Rejected { index: 0 }
+        }
+    })?;
     let width = data.settings.width as usize;
     let mut row = [0u8; 3 * RENDER_WIDTH];
     let row = row

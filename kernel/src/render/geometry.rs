@@ -11,13 +11,13 @@ use super::lights::{light_geom, LightGeom, MAX_LIGHTS};
 use super::memory::{memory_needed, RenderMemory};
 use super::motion::{displacement, moved_into_frame, swept_box};
 use super::objects::{ObjectGeom, ObjectSlot, ShapeAccel};
-use super::scene::{Item, Light, Object, Problem, Shape};
+use super::scene::{Item, Light, Material, Object, Problem, Shape};
 use super::surface::{Prim, SurfacePoint};
 use super::SceneError;
 use crate::accel::bvh::{BuildOptions, Bvh};
 use crate::accel::{take, AccelFamily, BuildError, Counters, MemoryNeeded};
 use crate::geom::spawn::{cross, sub, unit, SpawnScalar};
-use crate::geom::{closer, Aabb, Primitive, Ray};
+use crate::geom::{closer, Aabb, Primitive, Ray, Sphere};
 use crate::scalar::Scalar;
 
 /// What a closest hit found.
@@ -57,12 +57,16 @@ pub(crate) struct Geometry<'a, S: Scalar, F: AccelFamily<S>> {
     pub(crate) lights: heapless::Vec<LightGeom<S>, MAX_LIGHTS>,
     /// Global id of the first light.
     light_base: u32,
+    /// Emissive primitives: every primitive of every object that emits
+    /// ([`super::emitters`]).
+    pub(crate) emitter_count: u32,
 }
 
 impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     /// Builds every object's accelerator into the caller's memory ([`memory_needed`]).
     pub(crate) fn build(
         objects: &'a [Object<'a, S>],
+        materials: &[Material],
         lights: &[Light],
         options: &F::Options,
         memory: RenderMemory<'a, S, F>,
@@ -90,6 +94,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
         }
         let slots = take(&mut slots, objects.len());
         let mut base = 0u32;
+        let mut emitter_count = 0u32;
         for (i, (o, slot)) in objects.iter().zip(slots.iter_mut()).enumerate() {
             let bad = |e| err(i, "shape", Problem::Build(e));
             if !super::scene::finite3(o.motion) {
@@ -109,6 +114,12 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
                 (_, b) => b.unwrap_or(Aabb::new([S::ZERO; 3], [S::ZERO; 3])),
             };
             let len = u32::try_from(o.shape.len()).unwrap_or(u32::MAX);
+            let emitted = emitted_by(o, materials);
+            let emitter_base = emitter_count;
+            if emitted != [0.0; 3] {
+                // At most the global ids' count, checked below.
+                emitter_count = emitter_count.saturating_add(len);
+            }
             let g = ObjectGeom {
                 accel,
                 shape: o.shape,
@@ -116,6 +127,9 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
                 material: o.material,
                 emission: o.emission,
                 vertex_normals: o.vertex_normals,
+                one_sided: o.one_sided,
+                emitted,
+                emitter_base,
                 motion,
                 swept,
             };
@@ -144,6 +158,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
             tlas,
             lights: heapless::Vec::new(),
             light_base: base,
+            emitter_count,
         };
         for (i, l) in lights.iter().enumerate() {
             let _ = geo.lights.push(
@@ -179,6 +194,12 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     pub(crate) fn objects(&self) -> impl Iterator<Item = (usize, &ObjectGeom<'a, S, F>)> {
         let built = self.objects.iter().map(|s| s.0.as_ref());
         built.enumerate().filter_map(|(i, o)| o.map(|o| (i, o)))
+    }
+
+    /// The objects' slots, in scene order (all filled).
+    #[inline]
+    pub(crate) fn slots(&self) -> &'a [ObjectSlot<'a, S, F>] {
+        self.objects
     }
 
     /// Object `i`.
@@ -330,8 +351,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
                 let p: [f64; 3] = core::array::from_fn(|k| {
                     v[0][k] + u * (v[1][k] - v[0][k]) + w * (v[2][k] - v[0][k]) + d[k]
                 });
-                let n = unit(cross(&sub(&v[1], &v[0]), &sub(&v[2], &v[0])))
-                    .unwrap_or_else(|| S::ray_dir(ray.data()).map(|x| -x.to_f64()));
+                let n = triangle_normal(&v, ray);
                 let shading = o
                     .vertex_normals
                     .get(local as usize)
@@ -348,12 +368,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
             Shape::Spheres(s) if F::SPHERES => {
                 let sp = s.get(local as usize)?;
                 let c = sp.center.map(S::to_f64);
-                // The hit point from the ray in the object's frame, then shifted back.
-                let o3 = S::vec_to_array(ray.origin()).map(S::to_f64);
-                let dir = S::ray_dir(ray.data()).map(S::to_f64);
-                let t = h.t.to_f64();
-                let q: [f64; 3] = core::array::from_fn(|k| o3[k] - d[k] + t * dir[k]);
-                let n = unit(sub(&q, &c)).unwrap_or(dir.map(|x| -x));
+                let n = sphere_normal(sp, ray, h.t, d);
                 let r = sp.radius.to_f64();
                 // The point on the sphere along the normal: the offset is taken from there.
                 let p: [f64; 3] = core::array::from_fn(|k| c[k] + r * n[k] + d[k]);
@@ -414,6 +429,67 @@ fn check_vertex_normals<S: Scalar>(o: &Object<'_, S>) -> Result<(), Problem> {
     } else {
         Err(Problem::NonFinite)
     }
+}
+
+impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
+    /// The unit geometric normal [`Geometry::surface_point`] gives for hit `h`, without the
+    /// rest of the surface point (no barycentrics). `None` for lights.
+    pub(crate) fn normal_at(&self, ray: &Ray<S>, h: &SceneHit<S>, time: f32) -> Option<[f32; 3]> {
+        let Surface::Object { object, local } = h.surface else {
+            return None;
+        };
+        let o = self.object(object)?;
+        match o.shape {
+            // A translation does not turn a triangle: no motion needed.
+            Shape::Triangles(t) => {
+                let v = t.get(local as usize)?.v.map(|p| p.map(S::to_f64));
+                Some(triangle_normal(&v, ray).map(|x| x as f32))
+            }
+            Shape::Spheres(s) if F::SPHERES => {
+                let d = o.motion.map_or([0.0; 3], |m| displacement::<S>(m, time));
+                let n = sphere_normal(s.get(local as usize)?, ray, h.t, d);
+                Some(n.map(|x| x as f32))
+            }
+            Shape::Spheres(_) => None,
+        }
+    }
+}
+
+/// A triangle's unit geometric normal `(v1 − v0) × (v2 − v0)` (degenerate: against the ray).
+fn triangle_normal<S: SpawnScalar>(v: &[[f64; 3]; 3], ray: &Ray<S>) -> [f64; 3] {
+    unit(cross(&sub(&v[1], &v[0]), &sub(&v[2], &v[0])))
+        .unwrap_or_else(|| S::ray_dir(ray.data()).map(|x| -x.to_f64()))
+}
+
+/// A sphere's unit outward normal at the ray's hit `t`, the sphere displaced by `d` (the hit
+/// point from the ray in the sphere's frame; at the centre: against the ray).
+fn sphere_normal<S: SpawnScalar>(sp: &Sphere<S>, ray: &Ray<S>, t: S, d: [f64; 3]) -> [f64; 3] {
+    let c = sp.center.map(S::to_f64);
+    let o3 = S::vec_to_array(ray.origin()).map(S::to_f64);
+    let dir = S::ray_dir(ray.data()).map(S::to_f64);
+    let t = t.to_f64();
+    let q: [f64; 3] = core::array::from_fn(|k| o3[k] - d[k] + t * dir[k]);
+    unit(sub(&q, &c)).unwrap_or(dir.map(|x| -x))
+}
+
+/// What object `o` emits: its emission plus its material's if that is emissive (checked
+/// values: finite, non-negative; a sum past `f32::MAX` saturates).
+pub(super) fn emitted_by<S: Scalar>(
+    o: &Object<'_, S>,
+    materials: &[Material],
+) -> super::scene::Rgb {
+    let e = match materials.get(o.material as usize) {
+        Some(Material::Emissive { radiance }) => *radiance,
+        _ => [0.0; 3],
+    };
+    core::array::from_fn(|k| {
+        let s = o.emission[k] + e[k];
+        if s > f32::MAX {
+            f32::MAX
+        } else {
+            s
+        }
+    })
 }
 
 fn union_bounds<S: Scalar, P: Primitive<S>>(prims: &[P]) -> Option<Aabb<S>> {

@@ -3,7 +3,7 @@
 //! what the render plan says the scene needs. Also the camera-ray-only loop and the helpers
 //! the path integrator ([`super::path`]) shares.
 
-use super::geometry::Surface;
+use super::geometry::{SceneHit, Surface};
 use super::lighting::{light_sum, Lobe};
 use super::sampling::{phong_lobe, tent, to_world, SampleStream};
 use super::scene::{Filter, Light, Material};
@@ -55,6 +55,9 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
             }
             Surface::Object { object, .. } => object,
         };
+        if plan.one_sided && behind_one_sided(r, ray, &hit, time, object, unit_at(dir, depth)) {
+            break;
+        }
         if plan.emitting_objects {
             radiance += throughput * emission_of(r, object);
         }
@@ -152,9 +155,9 @@ pub(crate) fn camera_sample<S: SpawnScalar, F: AccelFamily<S>>(
 
 /// Radiance of pixel `(x, y)` when the plan needs only what camera rays see
 /// ([`RenderPlan::camera_rays_only`]): one ray through the pixel centre from the renderer's
-/// eye ray, a static scene, no lights to sample and nothing reflecting.
-/// Emitters, light surfaces seen directly and the background are then the whole picture;
-/// other surfaces are black. The same bits as [`sample_radiance`] under that plan (the same
+/// eye ray, a static scene, no lights to sample, no emissive geometry and nothing reflecting.
+/// Light surfaces seen directly and the background are then the whole picture; objects are
+/// black. The same bits as [`sample_radiance`] under that plan (the same
 /// operations in the same order), without its sample stream, path state and bounce loop.
 #[cfg_attr(not(target_os = "none"), inline(always))]
 pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>>(
@@ -175,10 +178,9 @@ pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>>(
         None => Vec3::from_array(r.background),
         Some(hit) => match hit.surface {
             Surface::Light { light } => light_seen(r, light, d.normalize_or_zero()),
-            Surface::Object { object, .. } => match material_of(r, object) {
-                Some(Material::Emissive { radiance }) => Vec3::from_array(*radiance),
-                _ => return Vec3::ZERO,
-            },
+            // Nothing emits under this plan (emissive geometry lights the scene, so it takes
+            // the general loop) and nothing is lit.
+            Surface::Object { .. } => return Vec3::ZERO,
         },
     };
     // As `sample_radiance` adds it: zero radiance plus unit throughput times what is seen.
@@ -196,6 +198,24 @@ pub(super) fn material_of<'r, S: SpawnScalar, F: AccelFamily<S>>(
         .and_then(|o| r.materials.get(o.material as usize))
 }
 
+/// True if hit `hit` of `ray` (unit direction `dir`) lies on the back of object `object` and
+/// the object is one-sided ([`super::Object::one_sided`]): the back is black and ends the path.
+/// The side is the one shading sees: the sign of `dir` against the surface point's normal.
+#[inline]
+pub(super) fn behind_one_sided<S: SpawnScalar, F: AccelFamily<S>>(
+    r: &Renderer<'_, S, F>,
+    ray: &Ray<S>,
+    hit: &SceneHit<S>,
+    time: f32,
+    object: usize,
+    dir: Vec3,
+) -> bool {
+    r.geometry.object(object).is_some_and(|o| o.one_sided)
+        && r.geometry
+            .normal_at(ray, hit, time)
+            .is_some_and(|n| Vec3::from_array(n).dot(dir) > 0.0)
+}
+
 /// Radiance object `object` emits ([`super::Object::emission`]; zero for an index the
 /// renderer's checks rule out).
 #[inline]
@@ -206,6 +226,19 @@ pub(super) fn emission_of<S: SpawnScalar, F: AccelFamily<S>>(
     r.geometry
         .object(object)
         .map_or(Vec3::ZERO, |o| Vec3::from_array(o.emission))
+}
+
+/// Radiance object `object` emits as emissive geometry: its emission plus an emissive
+/// material's (zero for an index the renderer's checks rule out).
+#[cfg_attr(not(feature = "path-tracing"), allow(dead_code))]
+#[inline]
+pub(super) fn emitted<S: SpawnScalar, F: AccelFamily<S>>(
+    r: &Renderer<'_, S, F>,
+    object: usize,
+) -> Vec3 {
+    r.geometry
+        .object(object)
+        .map_or(Vec3::ZERO, |o| Vec3::from_array(o.emitted))
 }
 
 /// The path's direction at bounce `depth` as a unit vector: the camera's (depth 0) is

@@ -2,6 +2,7 @@
 //! the point's lobe, and the light-sampling densities multiple importance sampling compares
 //! with the BSDF's.
 
+use super::emitters;
 use super::geometry::Geometry;
 use super::lights::LightGeom;
 use super::sampling::{power_heuristic, to_world, uniform_cone, SampleStream};
@@ -23,7 +24,8 @@ pub(super) enum Lobe {
     Diffuse,
     /// The normalised Phong lobe around the unit mirror direction: the weight is the lobe's
     /// density `(n+1)/(2π)·cos^n α` (the BSDF times `cos θ`, over the reflectance), which is
-    /// also BSDF sampling's density.
+    /// also BSDF sampling's density. Shaded by the path integrator alone.
+    #[cfg_attr(not(feature = "path-tracing"), allow(dead_code))]
     Glossy {
         /// Unit mirror direction.
         mirror: Vec3,
@@ -36,7 +38,7 @@ impl Lobe {
     /// The weight of light from `to / len` (any length `len > 0`) at `cos = nf·wi > 0`, and
     /// BSDF sampling's density of that direction.
     #[inline]
-    fn weigh(self, to: Vec3, len: f32, cos: f32) -> (f32, f32) {
+    pub(super) fn weigh(self, to: Vec3, len: f32, cos: f32) -> (f32, f32) {
         match self {
             Self::Diffuse => (cos, cos * FRAC_1_PI),
             Self::Glossy { mirror, exponent } => {
@@ -164,8 +166,18 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
             continue;
         }
         stats.shadow_rays += 1;
-        if visible(r, sp, target, time) {
+        if visible(r, sp, target, time, false) {
             sum += contribution;
+        }
+    }
+    if r.plan.emissive_geometry {
+        if let Some(s) = emitters::sample(r, pf, nf, lobe, mis, time, stream) {
+            if s.contribution != Vec3::ZERO && facing.leaves(Vec3::from_array(s.target) - pf) {
+                stats.shadow_rays += 1;
+                if visible(r, sp, s.target, time, true) {
+                    sum += s.contribution;
+                }
+            }
         }
     }
     sum
@@ -174,6 +186,7 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
 /// The solid-angle density with which [`light_sum`] samples the unit direction `dir` from
 /// `from` towards light `i`, whose surface a ray along `dir` hit (0 where it samples nothing:
 /// point lights, a rectangle's back, the inside of a sphere light).
+#[cfg_attr(not(feature = "path-tracing"), allow(dead_code))]
 pub(super) fn light_pdf<S: SpawnScalar, F: AccelFamily<S>>(
     lights: &[Light],
     geometry: &Geometry<'_, S, F>,
@@ -215,15 +228,23 @@ pub(super) fn light_pdf<S: SpawnScalar, F: AccelFamily<S>>(
     }
 }
 
-/// True if nothing blocks the segment from the surface point to `target`. Inlined on hosted
-/// targets as [`light_sum`] is (two integrators call it; left alone, the optimiser keeps it
-/// out of line and the direct integrator pays the calls).
+/// Shadow rays towards a point on emissive geometry stop this fraction of the distance short
+/// of it: the emitter itself blocks light, so the ray must end before its surface, and the
+/// sampled point carries `f32` rounding (the shadow rule's own shortening,
+/// [`crate::spawn::SHADOW_SHORTEN`], is for exact targets).
+const EMITTER_SHORTEN: f64 = 1.0 / 1024.0;
+
+/// True if nothing blocks the segment from the surface point to `target` (`on_surface`: a
+/// point on emissive geometry, the segment shortened by [`EMITTER_SHORTEN`]). Inlined on
+/// hosted targets as [`light_sum`] is (two integrators call it; left alone, the optimiser
+/// keeps it out of line and the direct integrator pays the calls).
 #[cfg_attr(not(target_os = "none"), inline(always))]
 fn visible<S: SpawnScalar, F: AccelFamily<S>>(
     r: &Renderer<'_, S, F>,
     sp: &SurfacePoint<'_, S>,
     target: [f32; 3],
     time: f32,
+    on_surface: bool,
 ) -> bool {
     let p = sp.position;
     let toward = [
@@ -244,7 +265,12 @@ fn visible<S: SpawnScalar, F: AccelFamily<S>>(
         // Origin and target coincide (or the origin left the range): count as lit.
         return true;
     };
-    let Ok(ray) = ray.with_interval(S::ZERO, shadow_t_max::<S>(len)) else {
+    let t_max = if on_surface {
+        S::t_down(len * (1.0 - EMITTER_SHORTEN), 1)
+    } else {
+        shadow_t_max::<S>(len)
+    };
+    let Ok(ray) = ray.with_interval(S::ZERO, t_max) else {
         return true;
     };
     !r.geometry.occluded(&ray, time, &mut NoStats)

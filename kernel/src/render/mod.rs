@@ -17,6 +17,7 @@
 //! separate dimension pairs of the sample stream ([`sampling`]).
 
 mod camera;
+mod emitters;
 mod geometry;
 mod integrator;
 mod lighting;
@@ -24,6 +25,7 @@ mod lights;
 mod memory;
 mod motion;
 mod objects;
+#[cfg(feature = "path-tracing")]
 mod path;
 pub mod sampling;
 mod scene;
@@ -75,6 +77,12 @@ pub struct RenderPlan {
     pub integrator: Integrator,
     /// Some object emits ([`Object::emission`]): hits add its radiance.
     pub emitting_objects: bool,
+    /// Some object emits (its [`Object::emission`] or an emissive material): next-event
+    /// estimation samples its surfaces as area lights.
+    pub emissive_geometry: bool,
+    /// Some object is [`Object::one_sided`]: hits on a surface's back are checked (black, the
+    /// path ends).
+    pub one_sided: bool,
     /// Some radiance is found only by rays that hit it, not by sampling the lights: a
     /// background that is not black, an emissive material or an emitting object. Without it
     /// the path integrator ends a path at its last vertex once the lights are sampled.
@@ -90,13 +98,13 @@ pub struct RenderPlan {
 
 impl RenderPlan {
     /// True when camera rays are all a render casts: the direct integrator, one sample at each
-    /// pixel centre, a pinhole, nothing moving, no lights, no emitting objects and nothing
-    /// reflecting. The renderer then runs a first-hit loop without sample streams or a bounce
+    /// pixel centre, a pinhole, nothing moving, no lights, no emissive geometry (emitting
+    /// objects or emissive materials) and nothing reflecting. The renderer then runs a first-hit loop without sample streams or a bounce
     /// loop (the same bits).
     #[must_use]
     pub const fn camera_rays_only(&self) -> bool {
         matches!(self.integrator, Integrator::Direct)
-            && !self.emitting_objects
+            && !self.emissive_geometry
             && self.pixel_centre
             && !self.lens
             && !self.motion
@@ -130,6 +138,10 @@ impl RenderPlan {
             area_lights: count(true),
             integrator: settings.integrator,
             emitting_objects,
+            emissive_geometry: scene.objects.iter().any(|o| {
+                !o.shape.is_empty() && geometry::emitted_by(o, scene.materials) != [0.0; 3]
+            }),
+            one_sided: scene.objects.iter().any(|o| o.one_sided),
             unsampled_emission: emitting_objects
                 || scene.background != [0.0; 3]
                 || used(|m| matches!(m, Material::Emissive { .. })),
@@ -165,6 +177,12 @@ impl fmt::Display for RenderPlan {
         )?;
         if self.emitting_objects {
             write!(f, "; emitting objects")?;
+        }
+        if self.emissive_geometry {
+            write!(f, "; emissive geometry sampled as lights")?;
+        }
+        if self.one_sided {
+            write!(f, "; one-sided surfaces")?;
         }
         match self.integrator {
             Integrator::Direct => write!(
@@ -285,7 +303,8 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Renderer<'a, S, F> {
         let camera = CameraFrame::new(&scene.camera, settings.width, settings.height)?;
         scene::check_rgb(scene.background, false)
             .map_err(|p| SceneError::new(Item::Settings, 0, "background", p))?;
-        let geometry = Geometry::build(scene.objects, scene.lights, &accel, memory)?;
+        let geometry =
+            Geometry::build(scene.objects, scene.materials, scene.lights, &accel, memory)?;
         Ok(Self {
             geometry,
             materials: scene.materials,
@@ -342,12 +361,16 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Renderer<'a, S, F> {
                     sum += integrator::sample_radiance(self, x, y, &mut stream, stats);
                 }
             }
+            #[cfg(feature = "path-tracing")]
             Integrator::Path { max_length } => {
                 for k in 0..spp {
                     let mut stream = self.sampler.stream(index, k);
                     sum += path::sample_radiance(self, x, y, max_length, &mut stream, stats);
                 }
             }
+            // Rejected by `Renderer::new` (`check_settings`).
+            #[cfg(not(feature = "path-tracing"))]
+            Integrator::Path { .. } => {}
         }
         // One sample: the mean is the sample (x / 1 is x, bit for bit).
         if spp == 1 {
@@ -478,8 +501,13 @@ fn check_settings(s: &Settings) -> Result<(), SceneError> {
         };
         return err("height", p);
     }
-    if let Integrator::Path { max_length: 0 } = s.integrator {
-        return err("max_length", Problem::NotPositive);
+    if let Integrator::Path { max_length } = s.integrator {
+        if !cfg!(feature = "path-tracing") {
+            return err("integrator", Problem::NotLinked);
+        }
+        if max_length == 0 {
+            return err("max_length", Problem::NotPositive);
+        }
     }
     Ok(())
 }

@@ -15,8 +15,11 @@
 //! value used) for Russian roulette whenever the throughput's largest channel is below 1 (the
 //! survival probability).
 
+use super::emitters;
 use super::geometry::Surface;
-use super::integrator::{camera_sample, emission_of, light_seen, material_of, reflect};
+use super::integrator::{
+    behind_one_sided, camera_sample, emitted, light_seen, material_of, reflect,
+};
 use super::lighting::{light_pdf, light_sum, phong_density, Lobe};
 use super::sampling::{cosine_hemisphere, phong_lobe, to_world, SampleStream};
 use super::scene::{Integrator, Material};
@@ -37,8 +40,9 @@ enum Previous {
     /// A vertex whose lights were sampled with MIS: the power heuristic of the BSDF's density
     /// `pdf` against the light's from `position`.
     Sampled { position: Vec3, pdf: f32 },
-    /// The path's last vertex: its lights were sampled with weight 1 (weight 0 here).
-    LightsDone,
+    /// The path's last vertex, at `position`: its lights were sampled with weight 1 (weight 0
+    /// here, unless light sampling cannot reach the surface hit).
+    LightsDone { position: Vec3 },
 }
 
 /// Radiance of one pixel sample under the path integrator with paths of at most `max_length`
@@ -77,24 +81,42 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
                         let light_pdf = light_pdf(r.lights, &r.geometry, light, position, dir);
                         super::sampling::power_heuristic(pdf, light_pdf)
                     }
-                    Previous::LightsDone => 0.0,
+                    Previous::LightsDone { .. } => 0.0,
                 };
                 if weight > 0.0 {
                     radiance += throughput * light_seen(r, light, dir) * weight;
                 }
                 break;
             }
-            Surface::Object { object, .. } => object,
+            Surface::Object { object, local } => (object, local),
         };
-        if plan.emitting_objects {
-            radiance += throughput * emission_of(r, object);
+        let (object, local) = object;
+        if plan.one_sided && behind_one_sided(r, ray, &hit, time, object, dir) {
+            break;
+        }
+        if plan.emissive_geometry {
+            let le = emitted(r, object);
+            if le != Vec3::ZERO {
+                // As for the lights above: weighted against next-event estimation's density.
+                let density = |from| {
+                    let t = S::to_f64(hit.t) as f32;
+                    emitters::density(r, object, local, t, from, dir, time)
+                };
+                let weight = match previous {
+                    Previous::Specular => 1.0,
+                    Previous::Sampled { position, pdf } => {
+                        super::sampling::power_heuristic(pdf, density(position))
+                    }
+                    // Light sampling reached it unless its density is zero.
+                    Previous::LightsDone { position } if density(position) > 0.0 => 0.0,
+                    Previous::LightsDone { .. } => 1.0,
+                };
+                radiance += throughput * le * weight;
+            }
         }
         let material = match material_of(r, object) {
-            None => break,
-            Some(Material::Emissive { radiance: e }) => {
-                radiance += throughput * Vec3::from_array(*e);
-                break;
-            }
+            // Emitted radiance was added above.
+            None | Some(Material::Emissive { .. }) => break,
             Some(m) => m,
         };
         if segments >= max_length {
@@ -161,7 +183,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
             Some(pdf) if mis => Previous::Sampled { position, pdf },
             // The last segment can add only radiance light sampling does not reach.
             Some(_) if !plan.unsampled_emission => break,
-            Some(_) => Previous::LightsDone,
+            Some(_) => Previous::LightsDone { position },
         };
         dir = wi;
         segments += 1;

@@ -38,9 +38,11 @@ pub enum Material {
         /// Lobe exponent `n >= 1`: larger is sharper.
         exponent: f32,
     },
-    /// Emits `radiance` from both sides and reflects nothing. Seen by camera and reflection
-    /// rays; not sampled as a light (use a [`Light`] for that). A surface that both emits and
-    /// reflects is any other material with [`Object::emission`].
+    /// Emits `radiance` (from both sides unless the object is [`Object::one_sided`]) and
+    /// reflects nothing. An area light: seen by camera and reflection rays, sampled by
+    /// next-event estimation in both integrators (the direct one lights diffuse surfaces by
+    /// it), casting shadows like any surface. A surface that both emits and reflects is any
+    /// other material with [`Object::emission`].
     Emissive {
         /// Emitted radiance per channel, `>= 0`.
         radiance: Rgb,
@@ -90,15 +92,21 @@ pub struct Object<'a, S: Scalar> {
     /// Displacement from shutter open to shutter close (linear motion); zero for a static
     /// object. At shutter time `s ∈ [0, 1)` the object sits at its position plus `s·motion`.
     pub motion: [f32; 3],
-    /// Radiance every surface of the object emits from both sides, per channel `>= 0`, on top
-    /// of what its material reflects. Seen by camera and reflection rays (not sampled as a
-    /// light: use a [`Light`] for that). Zero for most objects.
+    /// Radiance every surface of the object emits, per channel `>= 0`, on top of what its
+    /// material reflects; from both sides unless [`Object::one_sided`]. An area light, as an
+    /// emissive material is ([`Material::Emissive`]). Zero for most objects.
     pub emission: Rgb,
     /// Smooth shading: for each triangle of a [`Shape::Triangles`] shape, the normals at its
     /// three vertices (any length; interpolated by the hit's barycentrics and normalised), or
     /// empty for flat shading. A triangle whose normals are all zero is shaded flat. The
     /// geometric normal still decides offsets, sidedness and which directions leave the surface.
     pub vertex_normals: &'a [[[f32; 3]; 3]],
+    /// One-sided: the object reflects and emits only on the front of its surfaces, the side
+    /// the geometric normal points to (a triangle's `(v1 − v0) × (v2 − v0)`: its vertices run
+    /// counter-clockwise seen from the front; a sphere's outside). Seen from behind it is
+    /// black, and it blocks light from both sides. `false` (two-sided, the default): both
+    /// sides reflect and emit alike.
+    pub one_sided: bool,
 }
 
 impl<'a, S: Scalar> Object<'a, S> {
@@ -111,6 +119,7 @@ impl<'a, S: Scalar> Object<'a, S> {
             motion: [0.0; 3],
             emission: [0.0; 3],
             vertex_normals: &[],
+            one_sided: false,
         }
     }
     /// True if the object moves during the shutter interval.
@@ -217,6 +226,11 @@ pub enum Integrator {
     /// is sampled (next-event estimation) and the BSDF is sampled, the two combined by multiple
     /// importance sampling (power heuristic); Russian roulette once a path has
     /// [`Integrator::ROULETTE_AFTER`] segments.
+    ///
+    /// Linked only with the kernel's `path-tracing` feature; without it the variant still
+    /// exists (scene files and settings keep one shape) and [`crate::render::Renderer::new`]
+    /// rejects it with a [`SceneError`] on [`Item::Settings`], field `integrator`,
+    /// [`Problem::NotLinked`].
     Path {
         /// Most segments of a path (`>= 1`).
         max_length: u32,
@@ -351,8 +365,9 @@ pub enum Problem {
         /// The length required.
         expected: usize,
     },
-    /// A kind of primitive this renderer's accelerator family leaves out
-    /// ([`crate::AccelFamily::SPHERES`]).
+    /// A part of the renderer this build leaves out: a kind of primitive the accelerator
+    /// family does not link ([`crate::AccelFamily::SPHERES`]), or [`Integrator::Path`] without
+    /// the kernel's `path-tracing` feature.
     NotLinked,
 }
 
@@ -404,7 +419,7 @@ impl fmt::Display for Problem {
             }
             Self::Length { expected } => write!(f, "must have {expected} entries"),
             Self::Build(e) => write!(f, "{e}"),
-            Self::NotLinked => write!(f, "this renderer is built without this kind of primitive"),
+            Self::NotLinked => write!(f, "this renderer is built without it"),
         }
     }
 }

@@ -49,6 +49,8 @@ pub struct ObjectData {
     pub motion: [f32; 3],
     /// Emitted radiance ([`Object::emission`]).
     pub emission: Rgb,
+    /// Front side only ([`Object::one_sided`]).
+    pub one_sided: bool,
 }
 
 /// A whole scene as `f32` data, with the settings it is meant to be rendered with.
@@ -213,6 +215,7 @@ impl<'d> SceneData<'d> {
                 motion: o.motion,
                 emission: o.emission,
                 vertex_normals,
+                one_sided: o.one_sided,
             };
         }
         let n = self.objects.len();
@@ -245,6 +248,7 @@ const fn still(shape: ShapeRange, material: u32) -> ObjectData {
         material,
         motion: [0.0; 3],
         emission: [0.0; 3],
+        one_sided: false,
     }
 }
 
@@ -409,6 +413,7 @@ const CORNELL_OBJECTS: [ObjectData; 8] = [
         material: 5,
         motion: [0.3, 0.0, 0.0],
         emission: [0.0; 3],
+        one_sided: false,
     },
     // Empty objects are allowed (and cost nothing).
     still(tris(20, 0), 0),
@@ -618,12 +623,14 @@ const MOTION_OBJECTS: [ObjectData; 4] = [
         material: 1,
         motion: [0.0, 0.0, 0.5],
         emission: [0.0; 3],
+        one_sided: false,
     },
     ObjectData {
         shape: spheres(0, 1),
         material: 2,
         motion: [0.0, 0.4, 0.0],
         emission: [0.0; 3],
+        one_sided: false,
     },
     still(spheres(1, 1), 3),
 ];

@@ -341,3 +341,31 @@ pub fn query<S: TestScalar, A: Accel<S>>(
     }
     Ok(hit)
 }
+
+/// Renders `scene` whole into linear RGB (row-major) with the default accelerator, memory
+/// sized by [`raykernel::render::memory_needed`].
+pub fn render_linear<S: raykernel::spawn::SpawnScalar>(
+    scene: &raykernel::render::Scene<'_, S>,
+    settings: raykernel::render::Settings,
+) -> Result<Vec<[f32; 3]>, raykernel::render::SceneError> {
+    use raykernel::render::{memory_needed, ObjectSlot, RenderMemory, Renderer, Tile};
+    let accel = AccelKind::default();
+    let n = memory_needed::<S, raykernel::AnyFamily>(scene.objects, &accel);
+    let mut objects = vec![ObjectSlot::<S>::EMPTY; n.objects];
+    let mut owned = OwnedMemory::<S>::sized(n.accel);
+    let memory = RenderMemory {
+        objects: &mut objects,
+        accel: owned.memory(),
+    };
+    let r = Renderer::new(scene, settings, accel, memory)?;
+    let (width, height) = (settings.width, settings.height);
+    let mut out = vec![[0.0f32; 3]; (width * height) as usize];
+    let tile = Tile {
+        x: 0,
+        y: 0,
+        width,
+        height,
+    };
+    r.render_tile(tile, &mut out)?;
+    Ok(out)
+}

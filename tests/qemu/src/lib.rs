@@ -24,6 +24,7 @@ pub fn fail_name(f: Fail) -> &'static str {
         Fail::Build => "build failed",
         Fail::Invalid => "validate() rejected the tree",
         Fail::Differs { .. } => "BVH differs from brute force",
+        Fail::NotLinked => "needs a kernel feature this build leaves out (path-tracing)",
     }
 }
 
