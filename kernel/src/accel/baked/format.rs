@@ -183,7 +183,11 @@ pub fn read_header(bytes: &[u8]) -> Result<Header, BakeError> {
             available: bytes.len(),
         });
     }
-    if bytes.get(field::MAGIC..field::MAGIC + 8) != Some(&MAGIC[..]) {
+    // As a fixed-size array, compared in two words (a slice comparison calls `memcmp`).
+    let magic: Option<[u8; 8]> = bytes
+        .get(field::MAGIC..field::MAGIC + 8)
+        .and_then(|m| m.try_into().ok());
+    if magic != Some(MAGIC) {
         return Err(BakeError::BadMagic);
     }
     let version = word(bytes, field::VERSION);

@@ -12,6 +12,13 @@
 //! Inlining is forced on hosted targets only (speed); bare-metal targets (`target_os =
 //! "none"`) leave it to the optimiser, which keeps one copy of the larger helpers (flash).
 
+use crate::scalar::Scalar;
+
+/// `|x|`.
+fn abs(x: f32) -> f32 {
+    libm::fabsf(x)
+}
+
 /// `(s, e)` with `s = fl(a + b)` and `s + e = a + b` exactly (Knuth's branch-free TwoSum).
 #[inline(always)]
 pub(crate) fn two_sum(a: f32, b: f32) -> (f32, f32) {
@@ -40,6 +47,7 @@ fn split(a: f32) -> (f32, f32) {
 /// `(p, e)` with `p = fl(a·b)` and `p + e = a·b` exactly (Dekker's TwoProduct, under the
 /// conditions of the module docs).
 #[cfg_attr(not(target_os = "none"), inline(always))]
+#[cfg_attr(target_os = "none", inline(never))]
 pub(crate) fn two_prod(a: f32, b: f32) -> (f32, f32) {
     let p = a * b;
     let (ah, al) = split(a);
@@ -58,6 +66,7 @@ impl Df {
     /// `a·b - c·d`, with a relative error below 2^-44 however much the products cancel: both
     /// products exactly (four terms), their sum distilled into one pair.
     #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline(never))]
     pub(crate) fn diff_of_products(a: f32, b: f32, c: f32, d: f32) -> Df {
         let (p, pe) = two_prod(a, b);
         let (q, qe) = two_prod(c, d);
@@ -73,6 +82,7 @@ impl Df {
 
     /// `self + other`, relative error about 2^-46 when both have the same sign (the only use).
     #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline(never))]
     pub(crate) fn add(self, other: Df) -> Df {
         let (s, e) = two_sum(self.hi, other.hi);
         let (hi, lo) = fast_two_sum(s, e + (self.lo + other.lo));
@@ -81,6 +91,7 @@ impl Df {
 
     /// `self·b`, relative error about 2^-46.
     #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline(never))]
     pub(crate) fn mul_f32(self, b: f32) -> Df {
         let (p, e) = two_prod(self.hi, b);
         let (hi, lo) = fast_two_sum(p, e + self.lo * b);
@@ -100,6 +111,7 @@ impl Df {
     /// remainder `self - q·d` (computed to about 2^-46), so the result is within a hair of
     /// the correctly rounded quotient. `d.hi` must be non-zero.
     #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline(never))]
     pub(crate) fn div(self, d: Df) -> f32 {
         let q = self.hi / d.hi;
         // r = self - q·d, where q·d.hi is taken exactly.
@@ -136,6 +148,46 @@ pub(crate) fn scale_to_2_60(m: f32) -> (f32, f32) {
     } else {
         (P60, r)
     }
+}
+
+/// `a·b - c·d` for values given as exact pairs (`a = a.0 + a.1`, from [`two_sum`] or a lone
+/// `f32` with a zero low part), as a value with its exact sign, zero exactly when it is zero.
+///
+/// Every part is scaled by one power of two that brings the largest high part up to the binade
+/// 2^60 ([`scale_to_2_60`]), so the products of parts keep their error terms (the inputs are
+/// below 2^44); the eight products of parts are then taken as exact pairs ([`two_prod`]) and the
+/// sign of their sixteen-term sum by [`exact_sum_sign`]. Odd: swapping `(a, b)` with `(c, d)`
+/// negates the result exactly. The exact fallback of every sign decision of the triangle test.
+#[inline(never)]
+pub(crate) fn exact_diff_of_products(
+    a: (f32, f32),
+    b: (f32, f32),
+    c: (f32, f32),
+    d: (f32, f32),
+) -> f32 {
+    let m = abs(a.0).max_of(abs(b.0)).max_of(abs(c.0)).max_of(abs(d.0));
+    if m == 0.0 {
+        return 0.0;
+    }
+    let (k1, k2) = scale_to_2_60(m);
+    let k = |x: f32| x * k1 * k2;
+    // The left factors of a·b and of -(c·d) (negating a factor negates both parts exactly).
+    let x = [k(a.0), k(a.1), -k(c.0), -k(c.1)];
+    let y = [k(b.0), k(b.1), k(d.0), k(d.1)];
+    // Product n: group g = n / 4 (a·b or -(c·d)), high or low part of each factor.
+    let products: [(f32, f32); 8] = core::array::from_fn(|n| {
+        let g = n / 4 * 2;
+        two_prod(x[(g + n / 2 % 2).min(3)], y[(g + n % 2).min(3)])
+    });
+    let terms: [f32; 16] = core::array::from_fn(|n| {
+        let (p, e) = products[(n / 2).min(7)];
+        if n % 2 == 0 {
+            p
+        } else {
+            e
+        }
+    });
+    exact_sum_sign(terms)
 }
 
 /// The sign of the exact sum of `terms`, as a value: after distillation (repeated error-free
@@ -234,6 +286,35 @@ mod tests {
             assert_eq!(got > 0.0, exact > 0.0, "{a:e} {b:e} {c:e} {d:e}");
             assert_eq!(got == 0.0, exact == 0.0, "{a:e} {b:e} {c:e} {d:e}");
             assert_eq!(exact_sum_sign([-p, -pe, q, qe]), -got);
+        }
+    }
+
+    /// `hi + lo` times 2^37 as an integer (exact for the pairs the test below builds).
+    fn fixed(p: (f32, f32)) -> i128 {
+        let scale = libm::exp2(37.0);
+        (p.0 as f64 * scale) as i128 + (p.1 as f64 * scale) as i128
+    }
+
+    #[test]
+    fn exact_diff_of_products_has_the_exact_sign() {
+        let mut st = 0xd1ff_0f9a_0d00_0017;
+        // Pairs from two_sum of values within 2^±12: multiples of 2^-35 below 2^14 (halved:
+        // 2^-36), so the products are exact in i128 once scaled by 2^37 each.
+        let pair = |st: &mut u64| two_sum(value(st, 12), value(st, 12));
+        for i in 0..50_000 {
+            let (a, b) = (pair(&mut st), pair(&mut st));
+            let (c, d) = match i % 4 {
+                0 => (b, a),                                           // exactly a·b
+                1 => ((b.0 * 2.0, b.1 * 2.0), (a.0 * 0.5, a.1 * 0.5)), // exactly a·b too
+                // Nearly a·b: b with about 2^-35 more (rounded, still a multiple of it).
+                2 => (a, two_sum(b.0, b.1 + libm::exp2f(-35.0))),
+                _ => (pair(&mut st), pair(&mut st)),
+            };
+            let exact = fixed(a) * fixed(b) - fixed(c) * fixed(d);
+            let got = exact_diff_of_products(a, b, c, d);
+            assert_eq!(got > 0.0, exact > 0, "{a:?} {b:?} {c:?} {d:?}");
+            assert_eq!(got == 0.0, exact == 0, "{a:?} {b:?} {c:?} {d:?}");
+            assert_eq!(exact_diff_of_products(c, d, a, b), -got);
         }
     }
 
