@@ -1,7 +1,7 @@
 //! Loading baked bytes in place: checks, then a [`Bvh`] or [`Bvh4`] borrowing the bytes.
 
 use super::error::BakeError;
-use super::format::{read_header, BakedKind, Header, Layout};
+use super::format::{checked_header, BakedKind, Header};
 use super::plain::{cast_slice, Plain};
 use super::scalar::BakedScalar;
 use crate::accel::bvh::{Bvh, Node};
@@ -12,7 +12,7 @@ use crate::geom::{Primitive, Triangle};
 /// nodes, ids and triangles are `bytes` itself. `bytes` must start at a multiple of 32 bytes
 /// (see [`BakedKind::align`]).
 ///
-/// Every field is checked (see [`read_header`]), every triangle, and the whole tree: links
+/// Every field is checked (see [`super::read_header`]), every triangle, and the whole tree: links
 /// only forward, every node reached once, leaves tiling the ids, ids a permutation, depth as
 /// recorded and within [`crate::bvh::MAX_DEPTH`], every leaf box holding its triangles padded by the
 /// traversal margin ([`Bvh::validate`]). A tree that loads answers every query exactly as brute force over its
@@ -45,34 +45,30 @@ fn sections<S: BakedScalar, N: Plain>(
     bytes: &[u8],
     kind: BakedKind,
 ) -> Result<(Header, &[N], &[u32], &[Triangle<S>]), BakeError> {
-    let header = read_header(bytes)?;
+    let (header, layout) = checked_header(bytes)?;
     if header.mode != S::MODE || header.kind != kind {
         return Err(BakeError::WrongStructure);
     }
     if cfg!(target_endian = "big") {
         return Err(BakeError::BigEndianTarget);
     }
+    let misaligned = BakeError::Misaligned {
+        required: kind.align(),
+    };
     if (bytes.as_ptr() as usize) % kind.align() != 0 {
-        return Err(BakeError::Misaligned {
-            required: kind.align(),
-        });
+        return Err(misaligned);
     }
-    let layout = Layout::of(kind, header.node_count, header.prim_count);
-    let (nodes, ids, prims) = layout
-        .and_then(|l| {
-            let nodes = cast_slice::<N>(bytes.get(l.nodes..l.ids)?)?;
-            let ids = cast_slice::<u32>(bytes.get(l.ids..l.prims)?)?;
-            let prims = cast_slice::<Triangle<S>>(bytes.get(l.prims..l.total)?)?;
-            Some((nodes, ids, prims))
-        })
-        // Unreachable: `read_header` checked the layout, and the alignment is checked above.
-        .ok_or(BakeError::Misaligned {
-            required: kind.align(),
-        })?;
-    if let Some(index) = prims.iter().position(|t| t.check().is_err()) {
-        return Err(BakeError::BadPrimitive {
-            index: index as u32,
-        });
+    let section = |range: core::ops::Range<usize>| bytes.get(range).ok_or(misaligned);
+    // Cannot fail: `checked_header` checked the layout against the length, and the alignment
+    // is checked above.
+    let nodes = cast_slice::<N>(section(layout.nodes..layout.ids)?).ok_or(misaligned)?;
+    let ids = cast_slice::<u32>(section(layout.ids..layout.prims)?).ok_or(misaligned)?;
+    let prims =
+        cast_slice::<Triangle<S>>(section(layout.prims..layout.total)?).ok_or(misaligned)?;
+    for (index, t) in (0u32..).zip(prims) {
+        if t.check().is_err() {
+            return Err(BakeError::BadPrimitive { index });
+        }
     }
     Ok((header, nodes, ids, prims))
 }
