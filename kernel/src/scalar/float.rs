@@ -16,7 +16,7 @@ mod rounded;
 use super::lanes::F4;
 use super::Scalar;
 use crate::error::{PointError, RayError};
-use eft::{exact_diff_of_products, recip_binade, scale_to_2_60, two_sum, Df};
+use eft::{exact_sum_of_products, recip_binade, scale_to_2_60, Df};
 
 /// Largest coordinate magnitude accepted in `f32` mode (2^40, about 1.1e12). Beyond it the
 /// triple products of the triangle test could overflow to infinity and silently lose hits.
@@ -390,11 +390,14 @@ impl FloatRay {
 }
 
 /// `p0·q1 - p1·q0` as a value with its exact sign, zero exactly when it is zero
-/// ([`exact_diff_of_products`]). Swapping `p` and `q` negates the result exactly, so a shared
+/// ([`exact_sum_of_products`]). Swapping `p` and `q` negates the result exactly, so a shared
 /// edge is seen with opposite signs from its two triangles (watertightness).
 #[inline(never)]
 fn exact_edge(p: &[f32; 3], q: &[f32; 3]) -> f32 {
-    exact_diff_of_products((p[0], 0.0), (q[1], 0.0), (p[1], 0.0), (q[0], 0.0))
+    exact_sum_of_products(
+        [p[0], -p[1], 0.0, 0.0, 0.0, 0.0],
+        [q[1], q[0], 0.0, 0.0, 0.0, 0.0],
+    )
 }
 
 /// True if the triangle has exactly zero area: `(b - a) × (c - a) = 0`.
@@ -402,8 +405,9 @@ fn exact_edge(p: &[f32; 3], q: &[f32; 3]) -> f32 {
 /// Each component is first evaluated in `f32`; one whose magnitude exceeds its rounding
 /// error bound (differences, products and their difference: under `4·2^-24` of the products'
 /// magnitudes, bounded here by `2^-21` of them plus `2^-120` for underflow) is surely
-/// non-zero. Otherwise the component is decided exactly: the differences as exact pairs
-/// ([`two_sum`]), their cross product component by [`exact_diff_of_products`].
+/// non-zero. Otherwise the component is decided exactly, expanded into the six products of
+/// coordinates it equals (`a_i·b_j - a_j·b_i + b_i·c_j - b_j·c_i + c_i·a_j - c_j·a_i`), by
+/// [`exact_sum_of_products`].
 fn zero_area(v: &[[f32; 3]; 3]) -> bool {
     const REL: f32 = 1.0 / 2_097_152.0; // 2^-21
     const ABS: f32 = 7.523_164e-37; // 2^-120
@@ -416,11 +420,12 @@ fn zero_area(v: &[[f32; 3]; 3]) -> bool {
             return false;
         }
     }
-    let d1: [(f32, f32); 3] = core::array::from_fn(|i| two_sum(v[1][i], -v[0][i]));
-    let d2: [(f32, f32); 3] = core::array::from_fn(|i| two_sum(v[2][i], -v[0][i]));
+    let [a, b, c] = v;
     [(1, 2), (2, 0), (0, 1)].iter().all(|&(i, j)| {
         let (i, j) = (i.min(2), j.min(2)); // as above
-        exact_diff_of_products(d1[i], d2[j], d1[j], d2[i]) == 0.0
+        let x = [a[i], -a[j], b[i], -b[j], c[i], -c[j]];
+        let y = [b[j], b[i], c[j], c[i], a[j], a[i]];
+        exact_sum_of_products(x, y) == 0.0
     })
 }
 

@@ -150,37 +150,29 @@ pub(crate) fn scale_to_2_60(m: f32) -> (f32, f32) {
     }
 }
 
-/// `a·b - c·d` for values given as exact pairs (`a = a.0 + a.1`, from [`two_sum`] or a lone
-/// `f32` with a zero low part), as a value with its exact sign, zero exactly when it is zero.
+/// `x[0]·y[0] + ... + x[5]·y[5]` as a value with its exact sign, zero exactly when it is zero
+/// (inputs below 2^44 in magnitude; exact unless both factors of one product lie over 2^110
+/// below the largest input, where a product's error term would underflow).
 ///
-/// Every part is scaled by one power of two that brings the largest high part up to the binade
-/// 2^60 ([`scale_to_2_60`]), so the products of parts keep their error terms (the inputs are
-/// below 2^44); the eight products of parts are then taken as exact pairs ([`two_prod`]) and the
-/// sign of their sixteen-term sum by [`exact_sum_sign`]. Odd: swapping `(a, b)` with `(c, d)`
-/// negates the result exactly. The exact fallback of every sign decision of the triangle test.
+/// Every input is scaled by one power of two that brings the largest up to the binade 2^60
+/// ([`scale_to_2_60`]), so the products keep their error terms; the six products are taken as
+/// exact pairs ([`two_prod`]) and the sign of their twelve-term sum by [`exact_sum_sign`]. Odd:
+/// negating every `x` negates the result exactly. The exact fallback of every sign decision of
+/// the triangle test.
 #[inline(never)]
-pub(crate) fn exact_diff_of_products(
-    a: (f32, f32),
-    b: (f32, f32),
-    c: (f32, f32),
-    d: (f32, f32),
-) -> f32 {
-    let m = abs(a.0).max_of(abs(b.0)).max_of(abs(c.0)).max_of(abs(d.0));
+pub(crate) fn exact_sum_of_products(x: [f32; 6], y: [f32; 6]) -> f32 {
+    let mut m = 0.0f32;
+    for (&a, &b) in x.iter().zip(&y) {
+        m = m.max_of(abs(a)).max_of(abs(b));
+    }
     if m == 0.0 {
         return 0.0;
     }
     let (k1, k2) = scale_to_2_60(m);
-    let k = |x: f32| x * k1 * k2;
-    // The left factors of a·b and of -(c·d) (negating a factor negates both parts exactly).
-    let x = [k(a.0), k(a.1), -k(c.0), -k(c.1)];
-    let y = [k(b.0), k(b.1), k(d.0), k(d.1)];
-    // Product n: group g = n / 4 (a·b or -(c·d)), high or low part of each factor.
-    let products: [(f32, f32); 8] = core::array::from_fn(|n| {
-        let g = n / 4 * 2;
-        two_prod(x[(g + n / 2 % 2).min(3)], y[(g + n % 2).min(3)])
-    });
-    let terms: [f32; 16] = core::array::from_fn(|n| {
-        let (p, e) = products[(n / 2).min(7)];
+    let k = |v: f32| v * k1 * k2;
+    let products: [(f32, f32); 6] = core::array::from_fn(|n| two_prod(k(x[n]), k(y[n])));
+    let terms: [f32; 12] = core::array::from_fn(|n| {
+        let (p, e) = products[(n / 2).min(5)];
         if n % 2 == 0 {
             p
         } else {
@@ -194,7 +186,7 @@ pub(crate) fn exact_diff_of_products(
 /// cascades of [`two_sum`], which keep the exact sum, until nothing moves) the last term
 /// carries the sign of the sum and is zero exactly when the sum is zero. The cascade is odd:
 /// negated terms give the negated result.
-#[inline(never)]
+#[inline(always)]
 pub(crate) fn exact_sum_sign<const N: usize>(mut terms: [f32; N]) -> f32 {
     // Each pass moves every non-zero remainder up past zeros and merges overlapping terms;
     // a fixed point is a non-overlapping expansion whose largest term is last. The bound only
@@ -289,32 +281,44 @@ mod tests {
         }
     }
 
-    /// `hi + lo` times 2^37 as an integer (exact for the pairs the test below builds).
-    fn fixed(p: (f32, f32)) -> i128 {
-        let scale = libm::exp2(37.0);
-        (p.0 as f64 * scale) as i128 + (p.1 as f64 * scale) as i128
-    }
-
     #[test]
-    fn exact_diff_of_products_has_the_exact_sign() {
+    fn exact_sum_of_products_has_the_exact_sign() {
         let mut st = 0xd1ff_0f9a_0d00_0017;
-        // Pairs from two_sum of values within 2^±12: multiples of 2^-35 below 2^14 (halved:
-        // 2^-36), so the products are exact in i128 once scaled by 2^37 each.
-        let pair = |st: &mut u64| two_sum(value(st, 12), value(st, 12));
+        // Values within 2^±16 are multiples of 2^-39 below 2^17 (halved or doubled: 2^-40,
+        // 2^18): scaled by 2^40 each, the products are integers below 2^115.
+        let scale = libm::exp2(40.0);
+        let fixed = |v: f32| (v as f64 * scale) as i128;
         for i in 0..50_000 {
-            let (a, b) = (pair(&mut st), pair(&mut st));
-            let (c, d) = match i % 4 {
-                0 => (b, a),                                           // exactly a·b
-                1 => ((b.0 * 2.0, b.1 * 2.0), (a.0 * 0.5, a.1 * 0.5)), // exactly a·b too
-                // Nearly a·b: b with about 2^-35 more (rounded, still a multiple of it).
-                2 => (a, two_sum(b.0, b.1 + libm::exp2f(-35.0))),
-                _ => (pair(&mut st), pair(&mut st)),
-            };
-            let exact = fixed(a) * fixed(b) - fixed(c) * fixed(d);
-            let got = exact_diff_of_products(a, b, c, d);
-            assert_eq!(got > 0.0, exact > 0, "{a:?} {b:?} {c:?} {d:?}");
-            assert_eq!(got == 0.0, exact == 0, "{a:?} {b:?} {c:?} {d:?}");
-            assert_eq!(exact_diff_of_products(c, d, a, b), -got);
+            let mut x: [f32; 6] = core::array::from_fn(|_| value(&mut st, 16));
+            let mut y: [f32; 6] = core::array::from_fn(|_| value(&mut st, 16));
+            match i % 4 {
+                // Exact cancellation: the last three products are the first three negated
+                // (some halved and doubled).
+                0 => {
+                    for k in 0..3 {
+                        (x[k + 3], y[k + 3]) = (-x[k] * 2.0, y[k] * 0.5);
+                    }
+                }
+                // Near cancellation: off by one unit in the last place of one factor.
+                1 => {
+                    for k in 0..3 {
+                        (x[k + 3], y[k + 3]) = (-x[k], y[k]);
+                    }
+                    y[5] = f32::from_bits(y[5].to_bits() + 1);
+                }
+                // Zeros, as the 2D edge function passes them.
+                2 => {
+                    for k in 2..6 {
+                        (x[k], y[k]) = (0.0, 0.0);
+                    }
+                }
+                _ => {}
+            }
+            let exact: i128 = x.iter().zip(&y).map(|(&a, &b)| fixed(a) * fixed(b)).sum();
+            let got = exact_sum_of_products(x, y);
+            assert_eq!(got > 0.0, exact > 0, "{x:?} {y:?}");
+            assert_eq!(got == 0.0, exact == 0, "{x:?} {y:?}");
+            assert_eq!(exact_sum_of_products(x.map(|v| -v), y), -got);
         }
     }
 
