@@ -155,14 +155,14 @@ pub(crate) fn check_permutation(ids: &[u32]) -> Result<(), InvalidTree> {
         // `black_box` hides the zero from the optimiser, so the array is filled by a short
         // store loop instead of a call to `memset` (whose routine alone costs more flash than
         // this whole check on a microcontroller).
-        let mut seen = [core::hint::black_box(0u64); WINDOW / 64];
+        let mut seen = [core::hint::black_box(0u32); WINDOW / 32];
         for &id in ids {
             let id = id as usize;
             if id >= n {
                 return Err(InvalidTree::BadPrimIds { prim: id as u32 });
             }
-            if let Some(word) = id.checked_sub(base).and_then(|k| seen.get_mut(k / 64)) {
-                let bit = 1 << ((id - base) % 64);
+            if let Some(word) = id.checked_sub(base).and_then(|k| seen.get_mut(k / 32)) {
+                let bit = 1 << ((id - base) % 32);
                 if *word & bit != 0 {
                     return Err(InvalidTree::BadPrimIds { prim: id as u32 });
                 }
