@@ -118,6 +118,8 @@ pub(crate) struct ObjectGeom<'a, S: Scalar, F: AccelFamily<S>> {
     pub(crate) material: u32,
     /// Emitted radiance (checked).
     pub(crate) emission: super::scene::Rgb,
+    /// Per-triangle vertex normals, empty or one entry per triangle (checked).
+    pub(super) vertex_normals: &'a [[[f32; 3]; 3]],
     /// Motion over the shutter, `None` when static.
     pub(super) motion: Option<[f32; 3]>,
     /// World box over the whole shutter interval (for a static object, its primitives' box).

@@ -94,6 +94,11 @@ pub struct Object<'a, S: Scalar> {
     /// of what its material reflects. Seen by camera and reflection rays (not sampled as a
     /// light: use a [`Light`] for that). Zero for most objects.
     pub emission: Rgb,
+    /// Smooth shading: for each triangle of a [`Shape::Triangles`] shape, the normals at its
+    /// three vertices (any length; interpolated by the hit's barycentrics and normalised), or
+    /// empty for flat shading. A triangle whose normals are all zero is shaded flat. The
+    /// geometric normal still decides offsets, sidedness and which directions leave the surface.
+    pub vertex_normals: &'a [[[f32; 3]; 3]],
 }
 
 impl<'a, S: Scalar> Object<'a, S> {
@@ -105,6 +110,7 @@ impl<'a, S: Scalar> Object<'a, S> {
             material,
             motion: [0.0; 3],
             emission: [0.0; 3],
+            vertex_normals: &[],
         }
     }
     /// True if the object moves during the shutter interval.
@@ -340,6 +346,11 @@ pub enum Problem {
     },
     /// A primitive could not be built into the accelerator.
     Build(crate::accel::BuildError),
+    /// A list whose length must be `expected` (for example one entry per triangle).
+    Length {
+        /// The length required.
+        expected: usize,
+    },
     /// A kind of primitive this renderer's accelerator family leaves out
     /// ([`crate::AccelFamily::SPHERES`]).
     NotLinked,
@@ -391,6 +402,7 @@ impl fmt::Display for Problem {
             Self::TooSmall { needed, available } => {
                 write!(f, "buffer too small: need {needed} slots, have {available}")
             }
+            Self::Length { expected } => write!(f, "must have {expected} entries"),
             Self::Build(e) => write!(f, "{e}"),
             Self::NotLinked => write!(f, "this renderer is built without this kind of primitive"),
         }
