@@ -16,7 +16,7 @@ mod rounded;
 use super::lanes::F4;
 use super::Scalar;
 use crate::error::{PointError, RayError};
-use eft::{exact_sum_sign, recip_binade, scale_to_2_60, two_prod, two_sum, Df};
+use eft::{exact_sum_of_products, recip_binade, scale_to_2_60, Df};
 
 /// Largest coordinate magnitude accepted in `f32` mode (2^40, about 1.1e12). Beyond it the
 /// triple products of the triangle test could overflow to infinity and silently lose hits.
@@ -270,6 +270,15 @@ impl FloatRay {
         [px - sx * pz, py - sy * pz, sz * pz]
     }
 
+    /// The three vertices of a triangle sheared ([`FloatRay::shear`]). Inlined into the
+    /// triangle test on hosted targets (speed); bare-metal targets keep one copy for the test
+    /// and the barycentrics (flash).
+    #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline(never))]
+    fn sheared(&self, v: &[[f32; 3]; 3]) -> [[f32; 3]; 3] {
+        [self.shear(&v[0]), self.shear(&v[1]), self.shear(&v[2])]
+    }
+
     /// True if the point at `t` lies in the triangle's box grown by half the traversal margin.
     ///
     /// A hit the watertight test reports on a well-conditioned triangle always passes. One on a
@@ -380,25 +389,15 @@ impl FloatRay {
     }
 }
 
-/// `p0·q1 - p1·q0` as a value with its exact sign, zero exactly when it is zero: both products
-/// as exact pairs ([`two_prod`], after bringing the inputs up to the binade 2^60 by
-/// [`scale_to_2_60`] so the pairs do not underflow), the sign of their four-term sum by
-/// [`exact_sum_sign`]. Swapping `p` and `q` negates the result exactly, so a shared edge is
-/// seen with opposite signs from its two triangles (watertightness).
+/// `p0·q1 - p1·q0` as a value with its exact sign, zero exactly when it is zero
+/// ([`exact_sum_of_products`]). Swapping `p` and `q` negates the result exactly, so a shared
+/// edge is seen with opposite signs from its two triangles (watertightness).
 #[inline(never)]
 fn exact_edge(p: &[f32; 3], q: &[f32; 3]) -> f32 {
-    let m = abs(p[0])
-        .max_of(abs(p[1]))
-        .max_of(abs(q[0]))
-        .max_of(abs(q[1]));
-    if m == 0.0 {
-        return 0.0;
-    }
-    let (k1, k2) = scale_to_2_60(m);
-    let k = |x: f32| x * k1 * k2;
-    let (x, xe) = two_prod(k(p[0]), k(q[1]));
-    let (y, ye) = two_prod(k(p[1]), k(q[0]));
-    exact_sum_sign([x, xe, -y, -ye])
+    exact_sum_of_products(
+        [p[0], -p[1], 0.0, 0.0, 0.0, 0.0],
+        [q[1], q[0], 0.0, 0.0, 0.0, 0.0],
+    )
 }
 
 /// True if the triangle has exactly zero area: `(b - a) × (c - a) = 0`.
@@ -406,10 +405,9 @@ fn exact_edge(p: &[f32; 3], q: &[f32; 3]) -> f32 {
 /// Each component is first evaluated in `f32`; one whose magnitude exceeds its rounding
 /// error bound (differences, products and their difference: under `4·2^-24` of the products'
 /// magnitudes, bounded here by `2^-21` of them plus `2^-120` for underflow) is surely
-/// non-zero. Otherwise the component is decided exactly: the differences as exact pairs
-/// ([`two_sum`]), scaled to the binade 2^60 ([`scale_to_2_60`]), the two products expanded
-/// into eight exact terms each ([`two_prod`]) and the sign of the sixteen-term sum taken by
-/// [`exact_sum_sign`].
+/// non-zero. Otherwise the component is decided exactly, expanded into the six products of
+/// coordinates it equals (`a_i·b_j - a_j·b_i + b_i·c_j - b_j·c_i + c_i·a_j - c_j·a_i`), by
+/// [`exact_sum_of_products`].
 fn zero_area(v: &[[f32; 3]; 3]) -> bool {
     const REL: f32 = 1.0 / 2_097_152.0; // 2^-21
     const ABS: f32 = 7.523_164e-37; // 2^-120
@@ -422,33 +420,30 @@ fn zero_area(v: &[[f32; 3]; 3]) -> bool {
             return false;
         }
     }
-    let d1: [(f32, f32); 3] = core::array::from_fn(|i| two_sum(v[1][i], -v[0][i]));
-    let d2: [(f32, f32); 3] = core::array::from_fn(|i| two_sum(v[2][i], -v[0][i]));
+    let [a, b, c] = v;
     [(1, 2), (2, 0), (0, 1)].iter().all(|&(i, j)| {
         let (i, j) = (i.min(2), j.min(2)); // as above
-        let m = abs(d1[i].0)
-            .max_of(abs(d1[j].0))
-            .max_of(abs(d2[i].0))
-            .max_of(abs(d2[j].0));
-        if m == 0.0 {
-            return true;
-        }
-        let (k1, k2) = scale_to_2_60(m);
-        let k = |x: f32| x * k1 * k2;
-        let mut terms = [0.0f32; 16];
-        let mut n = 0;
-        for (x, y, sign) in [(d1[i], d2[j], 1.0f32), (d1[j], d2[i], -1.0)] {
-            for a in [k(x.0), k(x.1)] {
-                for b in [k(y.0), k(y.1)] {
-                    let (p, e) = two_prod(a, b);
-                    terms[n & 15] = sign * p;
-                    terms[(n + 1) & 15] = sign * e;
-                    n += 2;
-                }
-            }
-        }
-        exact_sum_sign(terms) == 0.0
+        let x = [a[i], -a[j], b[i], -b[j], c[i], -c[j]];
+        let y = [b[j], b[i], c[j], c[i], a[j], a[i]];
+        exact_sum_of_products(x, y) == 0.0
     })
+}
+
+/// The slab test of one box: the IEEE operations of one lane of [`Scalar::slab_pair`], in the
+/// same order, so the same bits. Bare-metal targets run it once per box: their lanes are
+/// scalar code anyway, and one copy of it is the smallest in flash.
+#[cfg_attr(not(target_os = "none"), inline(always))]
+#[cfg_attr(target_os = "none", inline(never))]
+fn slab_box(r: &FloatRay, (lo, hi): (&[f32; 3], &[f32; 3]), t_min: f32, t_max: f32) -> Option<f32> {
+    let (mut near, mut far) = (t_min, t_max);
+    for i in 0..3 {
+        let a = (lo[i] - r.o_lo[i]) * r.inv[i];
+        let b = (hi[i] - r.o_hi[i]) * r.inv[i];
+        let (n, f) = (if a < b { a } else { b }, if a > b { a } else { b });
+        near = if n > near { n } else { near };
+        far = if f < far { f } else { far };
+    }
+    (near <= far * WIDEN).then_some(near)
 }
 
 impl Scalar for f32 {
@@ -534,6 +529,9 @@ impl Scalar for f32 {
 
     #[inline(always)]
     fn slab(r: &FloatRay, lo: &[f32; 3], hi: &[f32; 3], t_min: f32, t_max: f32) -> Option<f32> {
+        if cfg!(target_os = "none") {
+            return slab_box(r, (lo, hi), t_min, t_max);
+        }
         let [hit, _] = Self::slab_pair(r, (lo, hi), (lo, hi), t_min, t_max);
         hit
     }
@@ -546,6 +544,9 @@ impl Scalar for f32 {
         t_min: f32,
         t_max: f32,
     ) -> [Option<f32>; 2] {
+        if cfg!(target_os = "none") {
+            return [slab_box(r, a, t_min, t_max), slab_box(r, b, t_min, t_max)];
+        }
         // Per box and axis (lanes x, y, z, z), the plane distances, then the sequential fold
         // `t_near = max(t_min, near_x, near_y, near_z)` (and `t_far` likewise with `min`), run
         // for both boxes side by side in lanes 0 and 1. Every lane sees exactly the operations
@@ -610,9 +611,7 @@ impl Scalar for f32 {
     #[inline(always)]
     fn triangle_t(r: &FloatRay, v: &[[f32; 3]; 3], t_min: f32, t_max: f32) -> Option<f32> {
         // Translate to the ray origin, permute so the dominant axis is z, and shear.
-        let a = r.shear(&v[0]);
-        let b = r.shear(&v[1]);
-        let c = r.shear(&v[2]);
+        let [a, b, c] = r.sheared(v);
         // Edge functions; two-sided, so reject only if the signs differ. (Non-short-circuit
         // operators: one branch instead of six hard-to-predict ones.)
         let [eu, ev, ew] = FloatRay::edges(&a, &b, &c);
@@ -639,9 +638,7 @@ impl Scalar for f32 {
     }
 
     fn triangle_uv(r: &FloatRay, v: &[[f32; 3]; 3]) -> (f32, f32) {
-        let a = r.shear(&v[0]);
-        let b = r.shear(&v[1]);
-        let c = r.shear(&v[2]);
+        let [a, b, c] = r.sheared(v);
         // Clamped to [0, 1] as in fixed point: the exact solve can disagree in sign with the f32
         // edge functions that accepted the hit by a few subnormals (found by fuzzing).
         let unit = |w: f32| if w > 0.0 { w.min_of(1.0) } else { 0.0 };
@@ -825,6 +822,48 @@ mod tests {
             solved > 500_000 && certified * 2 > solved,
             "{certified} of {solved} certified"
         );
+    }
+
+    #[test]
+    fn slab_box_is_one_lane_of_slab_pair() {
+        fn next(state: &mut u64) -> u64 {
+            *state ^= *state << 13;
+            *state ^= *state >> 7;
+            *state ^= *state << 17;
+            *state
+        }
+        // Coordinates on a coarse grid, so rays start on planes and run along them (zero
+        // direction components: the NaN cases of the slab test) as often as not.
+        fn coord(state: &mut u64) -> f32 {
+            ((next(state) % 9) as f32 - 4.0) * 0.5
+        }
+        let mut st = 0x51ab_0b0c_0000_0003u64;
+        let mut tested = 0;
+        for _ in 0..200_000 {
+            let mut point = || [coord(&mut st), coord(&mut st), coord(&mut st)];
+            let (origin, dir) = (point(), point());
+            let (p, q, u, w) = (point(), point(), point(), point());
+            let Ok(r) = FloatRay::new(origin, dir) else {
+                continue;
+            };
+            let lo1: [f32; 3] = core::array::from_fn(|i| p[i].min_of(q[i]));
+            let hi1: [f32; 3] = core::array::from_fn(|i| p[i].max_of(q[i]));
+            let lo2: [f32; 3] = core::array::from_fn(|i| u[i].min_of(w[i]));
+            let hi2: [f32; 3] = core::array::from_fn(|i| u[i].max_of(w[i]));
+            let t_max = [f32::INFINITY, 1.0, 3.5][(next(&mut st) % 3) as usize];
+            let pair = <f32 as Scalar>::slab_pair(&r, (&lo1, &hi1), (&lo2, &hi2), 0.0, t_max);
+            let single = [
+                slab_box(&r, (&lo1, &hi1), 0.0, t_max),
+                slab_box(&r, (&lo2, &hi2), 0.0, t_max),
+            ];
+            assert_eq!(
+                pair.map(|t| t.map(f32::to_bits)),
+                single.map(|t| t.map(f32::to_bits)),
+                "{origin:?} {dir:?} {lo1:?} {hi1:?} {lo2:?} {hi2:?}"
+            );
+            tested += usize::from(pair.iter().any(Option::is_some));
+        }
+        assert!(tested > 10_000, "{tested} rays hit a box");
     }
 
     #[test]

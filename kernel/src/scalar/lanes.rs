@@ -246,7 +246,7 @@ mod portable {
         }
         #[inline(always)]
         pub(crate) fn splat(x: f32) -> Self {
-            Self([x; 4])
+            Self([x, x, x, x]) // written out: `[x; 4]` became a store loop through memory
         }
         /// Lane by lane (written out: no index, so no bounds check to prove away).
         #[inline(always)]

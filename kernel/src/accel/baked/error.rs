@@ -62,7 +62,7 @@ pub enum BakeError {
         /// Index of the node (4-wide: of the node whose slot holds the leaf).
         node: u32,
     },
-    /// The tree's structure is invalid (links, leaf ranges, primitive ids, depth).
+    /// The tree's structure is invalid (links, child boxes, leaf ranges, primitive ids, depth).
     Tree(InvalidTree),
     /// A writer was given a tree too large for the format (over `u32::MAX` bytes).
     TooLarge,
@@ -108,6 +108,9 @@ impl core::error::Error for BakeError {}
 
 impl From<InvalidTree> for BakeError {
     fn from(e: InvalidTree) -> Self {
-        Self::Tree(e)
+        match e {
+            InvalidTree::LeafTooSmall { node } => Self::LeafTooSmall { node: node as u32 },
+            e => Self::Tree(e),
+        }
     }
 }

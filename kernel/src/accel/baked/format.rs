@@ -177,13 +177,22 @@ pub(crate) fn word(bytes: &[u8], offset: usize) -> u32 {
 /// [`BakeError::UnsupportedVersion`], [`BakeError::BadField`], [`BakeError::WrongLength`] (with the field's offset),
 /// [`BakeError::BadChecksum`].
 pub fn read_header(bytes: &[u8]) -> Result<Header, BakeError> {
+    checked_header(bytes).map(|(header, _)| header)
+}
+
+/// [`read_header`], with the section layout it checked the header against.
+pub(crate) fn checked_header(bytes: &[u8]) -> Result<(Header, Layout), BakeError> {
     if bytes.len() < HEADER_LEN {
         return Err(BakeError::Truncated {
             needed: HEADER_LEN,
             available: bytes.len(),
         });
     }
-    if bytes.get(field::MAGIC..field::MAGIC + 8) != Some(&MAGIC[..]) {
+    // As a fixed-size array, compared in two words (a slice comparison calls `memcmp`).
+    let magic: Option<[u8; 8]> = bytes
+        .get(field::MAGIC..field::MAGIC + 8)
+        .and_then(|m| m.try_into().ok());
+    if magic != Some(MAGIC) {
         return Err(BakeError::BadMagic);
     }
     let version = word(bytes, field::VERSION);
@@ -250,12 +259,13 @@ pub fn read_header(bytes: &[u8]) -> Result<Header, BakeError> {
     if stored != computed {
         return Err(BakeError::BadChecksum { stored, computed });
     }
-    Ok(Header {
+    let header = Header {
         mode,
         kind,
         leaf_order: flags & FLAG_LEAF_ORDER != 0,
         prim_count,
         node_count,
         depth,
-    })
+    };
+    Ok((header, layout))
 }

@@ -1,6 +1,6 @@
 //! Structural checker for a built tree, called by tests after every build.
 
-use super::{Bvh, MAX_DEPTH, MAX_LEAF_SIZE};
+use super::{leaf_bounds, Bvh, MAX_DEPTH, MAX_LEAF_SIZE};
 use crate::geom::Primitive;
 use crate::scalar::Scalar;
 use core::fmt;
@@ -37,12 +37,10 @@ pub enum InvalidTree {
         /// The leaf.
         node: usize,
     },
-    /// A primitive's box is not inside the leaf that holds it.
-    PrimOutsideLeaf {
+    /// A leaf's box does not hold its primitives' boxes padded by the traversal margin.
+    LeafTooSmall {
         /// The leaf.
         node: usize,
-        /// The primitive.
-        prim: u32,
     },
     /// A primitive id is out of range, listed twice, or missing.
     BadPrimIds {
@@ -66,7 +64,11 @@ impl core::error::Error for InvalidTree {}
 
 impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
     /// Checks every invariant: children after and inside their parents, leaves tiling the id
-    /// slice in order, every primitive exactly once and inside its leaf, depth within the cap.
+    /// slice in order, every primitive exactly once, every leaf's box holding its primitives'
+    /// boxes padded by the traversal margin (the padded union [`Scalar::pad_bounds`] gives, as
+    /// the builder and refit compute it), depth within the cap and as recorded. One pass over
+    /// the nodes after the id check; a tree that passes answers every query as brute force
+    /// over its primitives does.
     ///
     /// # Errors
     /// The first violation found.
@@ -83,14 +85,17 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                 Err(InvalidTree::BadLeafRange { node: 0 })
             };
         }
-        let mut stack = [(0usize, 0usize); MAX_DEPTH + 2];
-        let mut sp = 1usize;
+        // Ids first: a permutation of `0..n` indexes a primitive whichever order they are in.
+        if self.prim_ids.len() != n {
+            return Err(InvalidTree::BadPrimIds { prim: n as u32 });
+        }
+        check_permutation(self.prim_ids)?;
+        // (node, depth) still to visit; each inner node pushes two, so depth + 2 entries.
+        let mut stack: heapless::Vec<(u32, u32), { MAX_DEPTH + 2 }> = heapless::Vec::new();
+        let _ = stack.push((0, 0));
         let mut next_first = 0usize;
-        while sp > 0 {
-            sp -= 1;
-            let Some(&(index, depth)) = stack.get(sp) else {
-                return Err(InvalidTree::TooDeep { depth: sp });
-            };
+        while let Some((index, depth)) = stack.pop() {
+            let (index, depth) = (index as usize, depth as usize);
             if depth > MAX_DEPTH {
                 return Err(InvalidTree::TooDeep { depth });
             }
@@ -106,20 +111,10 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                 next_first = first + count;
                 stats.leaf_count += 1;
                 stats.max_leaf_size = stats.max_leaf_size.max(node.count);
-                let Some(leaf_ids) = self.prim_ids.get(first..first + count) else {
-                    return Err(InvalidTree::BadLeafRange { node: index });
-                };
-                for (slot, &id) in (first..).zip(leaf_ids) {
-                    let at = if self.leaf_order { slot } else { id as usize };
-                    let Some(p) = self.prims.get(at) else {
-                        return Err(InvalidTree::BadPrimIds { prim: id });
-                    };
-                    if !node.bounds().contains(&p.bounds()) {
-                        return Err(InvalidTree::PrimOutsideLeaf {
-                            node: index,
-                            prim: id,
-                        });
-                    }
+                let leaf = (self.prim_ids, self.prims, self.leaf_order);
+                // `None` only for a range or id out of bounds, ruled out above.
+                if !leaf_bounds(leaf, (first, count)).is_some_and(|b| node.bounds().contains(&b)) {
+                    return Err(InvalidTree::LeafTooSmall { node: index });
                 }
                 continue;
             }
@@ -134,11 +129,9 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                 if !node.bounds().contains(&c.bounds()) {
                     return Err(InvalidTree::ChildOutsideParent { node: child });
                 }
-                let Some(slot) = stack.get_mut(sp) else {
+                if stack.push((child as u32, depth as u32 + 1)).is_err() {
                     return Err(InvalidTree::TooDeep { depth: depth + 1 });
-                };
-                *slot = (child, depth + 1);
-                sp += 1;
+                }
             }
         }
         if next_first != n {
@@ -147,37 +140,33 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
         if stats.depth != self.depth as usize {
             return Err(InvalidTree::TooDeep { depth: stats.depth });
         }
-        check_permutation(self.prim_ids).map(|()| stats)
+        Ok(stats)
     }
 }
 
-/// Every id in `0..ids.len()` exactly once, checked window by window with a fixed bitmap (no
-/// allocation): `O(n²/8192)` work, fine for the sizes tests use.
+/// Every id in `0..ids.len()` exactly once: each in range and none twice (`n` distinct ids
+/// below `n` are all of them), checked window by window with a fixed bitmap (no allocation):
+/// `O(n²/8192)` work, fine for the sizes tests use.
 pub(crate) fn check_permutation(ids: &[u32]) -> Result<(), InvalidTree> {
     const WINDOW: usize = 8192;
     let n = ids.len();
     let mut base = 0usize;
     while base < n {
-        let mut seen = [0u64; WINDOW / 64];
+        // `black_box` hides the zero from the optimiser, so the array is filled by a short
+        // store loop instead of a call to `memset` (whose routine alone costs more flash than
+        // this whole check on a microcontroller).
+        let mut seen = [core::hint::black_box(0u32); WINDOW / 32];
         for &id in ids {
             let id = id as usize;
             if id >= n {
                 return Err(InvalidTree::BadPrimIds { prim: id as u32 });
             }
-            if (base..base + WINDOW).contains(&id) {
-                let (word, bit) = ((id - base) / 64, (id - base) % 64);
-                if seen[word] & (1 << bit) != 0 {
+            if let Some(word) = id.checked_sub(base).and_then(|k| seen.get_mut(k / 32)) {
+                let bit = 1 << ((id - base) % 32);
+                if *word & bit != 0 {
                     return Err(InvalidTree::BadPrimIds { prim: id as u32 });
                 }
-                seen[word] |= 1 << bit;
-            }
-        }
-        // n distinct in-range ids in total means none is missing, but check each window anyway.
-        for k in 0..WINDOW.min(n - base) {
-            if seen[k / 64] & (1 << (k % 64)) == 0 {
-                return Err(InvalidTree::BadPrimIds {
-                    prim: (base + k) as u32,
-                });
+                *word |= bit;
             }
         }
         base += WINDOW;

@@ -2,7 +2,9 @@
 
 use super::node::EMPTY_SLOT;
 use super::Bvh4;
-use crate::accel::bvh::{check_permutation, InvalidTree, TreeStats, MAX_DEPTH, MAX_LEAF_SIZE};
+use crate::accel::bvh::{
+    check_permutation, leaf_bounds, InvalidTree, TreeStats, MAX_DEPTH, MAX_LEAF_SIZE,
+};
 use crate::geom::Primitive;
 use crate::scalar::Scalar;
 
@@ -14,7 +16,8 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
     /// Checks every invariant: used slots first and at least two per node (one only for a
     /// root over a single leaf), inner children after their parent and inside its slot box,
     /// every node reached exactly once, leaves tiling the id slice in depth-first order, every
-    /// primitive exactly once and inside its leaf's box, wide depth below [`MAX_DEPTH`] and as
+    /// primitive exactly once, every leaf's box holding its primitives' boxes padded by the
+    /// traversal margin (as [`crate::Bvh::validate`] checks), wide depth below [`MAX_DEPTH`] and as
     /// recorded. `TreeStats::depth` is the depth of the deepest wide node.
     ///
     /// # Errors
@@ -32,6 +35,11 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                 Err(InvalidTree::BadLeafRange { node: 0 })
             };
         }
+        // Ids first: a permutation of `0..n` indexes a primitive whichever order they are in.
+        if self.prim_ids.len() != n {
+            return Err(InvalidTree::BadPrimIds { prim: n as u32 });
+        }
+        check_permutation(self.prim_ids)?;
         // (child, count, depth): count 0 is the node `child`, otherwise a leaf.
         let mut stack = [(0u32, 0u32, 0u32); STACK];
         let mut sp = 1usize;
@@ -84,25 +92,14 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                     stats.leaf_count += 1;
                     stats.max_leaf_size = stats.max_leaf_size.max(k);
                     let first = c as usize;
-                    let Some(ids) = self.prim_ids.get(first..first.saturating_add(k as usize))
-                    else {
-                        return Err(InvalidTree::BadLeafRange { node: index });
-                    };
-                    for (at_slot, &id) in (first..).zip(ids) {
-                        let at = if self.leaf_order {
-                            at_slot
-                        } else {
-                            id as usize
-                        };
-                        let Some(p) = self.prims.get(at) else {
-                            return Err(InvalidTree::BadPrimIds { prim: id });
-                        };
-                        if !b.contains(&p.bounds()) {
-                            return Err(InvalidTree::PrimOutsideLeaf {
-                                node: index,
-                                prim: id,
-                            });
+                    let leaf = (self.prim_ids, self.prims, self.leaf_order);
+                    // `None` only for a range out of bounds (ids are checked above).
+                    match leaf_bounds(leaf, (first, k as usize)) {
+                        None => return Err(InvalidTree::BadLeafRange { node: first }),
+                        Some(lb) if !b.contains(&lb) => {
+                            return Err(InvalidTree::LeafTooSmall { node: index })
                         }
+                        Some(_) => {}
                     }
                 }
                 let Some(top) = stack.get_mut(sp) else {
@@ -118,6 +115,6 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
         if stats.depth != self.depth as usize {
             return Err(InvalidTree::TooDeep { depth: stats.depth });
         }
-        check_permutation(self.prim_ids).map(|()| stats)
+        Ok(stats)
     }
 }

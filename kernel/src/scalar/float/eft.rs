@@ -12,6 +12,13 @@
 //! Inlining is forced on hosted targets only (speed); bare-metal targets (`target_os =
 //! "none"`) leave it to the optimiser, which keeps one copy of the larger helpers (flash).
 
+use crate::scalar::Scalar;
+
+/// `|x|`.
+fn abs(x: f32) -> f32 {
+    libm::fabsf(x)
+}
+
 /// `(s, e)` with `s = fl(a + b)` and `s + e = a + b` exactly (Knuth's branch-free TwoSum).
 #[inline(always)]
 pub(crate) fn two_sum(a: f32, b: f32) -> (f32, f32) {
@@ -40,6 +47,7 @@ fn split(a: f32) -> (f32, f32) {
 /// `(p, e)` with `p = fl(a·b)` and `p + e = a·b` exactly (Dekker's TwoProduct, under the
 /// conditions of the module docs).
 #[cfg_attr(not(target_os = "none"), inline(always))]
+#[cfg_attr(target_os = "none", inline(never))]
 pub(crate) fn two_prod(a: f32, b: f32) -> (f32, f32) {
     let p = a * b;
     let (ah, al) = split(a);
@@ -58,6 +66,7 @@ impl Df {
     /// `a·b - c·d`, with a relative error below 2^-44 however much the products cancel: both
     /// products exactly (four terms), their sum distilled into one pair.
     #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline(never))]
     pub(crate) fn diff_of_products(a: f32, b: f32, c: f32, d: f32) -> Df {
         let (p, pe) = two_prod(a, b);
         let (q, qe) = two_prod(c, d);
@@ -73,6 +82,7 @@ impl Df {
 
     /// `self + other`, relative error about 2^-46 when both have the same sign (the only use).
     #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline(never))]
     pub(crate) fn add(self, other: Df) -> Df {
         let (s, e) = two_sum(self.hi, other.hi);
         let (hi, lo) = fast_two_sum(s, e + (self.lo + other.lo));
@@ -81,6 +91,7 @@ impl Df {
 
     /// `self·b`, relative error about 2^-46.
     #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline(never))]
     pub(crate) fn mul_f32(self, b: f32) -> Df {
         let (p, e) = two_prod(self.hi, b);
         let (hi, lo) = fast_two_sum(p, e + self.lo * b);
@@ -100,6 +111,7 @@ impl Df {
     /// remainder `self - q·d` (computed to about 2^-46), so the result is within a hair of
     /// the correctly rounded quotient. `d.hi` must be non-zero.
     #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline(never))]
     pub(crate) fn div(self, d: Df) -> f32 {
         let q = self.hi / d.hi;
         // r = self - q·d, where q·d.hi is taken exactly.
@@ -138,11 +150,43 @@ pub(crate) fn scale_to_2_60(m: f32) -> (f32, f32) {
     }
 }
 
+/// `x[0]·y[0] + ... + x[5]·y[5]` as a value with its exact sign, zero exactly when it is zero
+/// (inputs below 2^44 in magnitude; exact unless both factors of one product lie over 2^110
+/// below the largest input, where a product's error term would underflow).
+///
+/// Every input is scaled by one power of two that brings the largest up to the binade 2^60
+/// ([`scale_to_2_60`]), so the products keep their error terms; the six products are taken as
+/// exact pairs ([`two_prod`]) and the sign of their twelve-term sum by [`exact_sum_sign`]. Odd:
+/// negating every `x` negates the result exactly. The exact fallback of every sign decision of
+/// the triangle test.
+#[inline(never)]
+pub(crate) fn exact_sum_of_products(x: [f32; 6], y: [f32; 6]) -> f32 {
+    let mut m = 0.0f32;
+    for (&a, &b) in x.iter().zip(&y) {
+        m = m.max_of(abs(a)).max_of(abs(b));
+    }
+    if m == 0.0 {
+        return 0.0;
+    }
+    let (k1, k2) = scale_to_2_60(m);
+    let k = |v: f32| v * k1 * k2;
+    let products: [(f32, f32); 6] = core::array::from_fn(|n| two_prod(k(x[n]), k(y[n])));
+    let terms: [f32; 12] = core::array::from_fn(|n| {
+        let (p, e) = products[(n / 2).min(5)];
+        if n % 2 == 0 {
+            p
+        } else {
+            e
+        }
+    });
+    exact_sum_sign(terms)
+}
+
 /// The sign of the exact sum of `terms`, as a value: after distillation (repeated error-free
 /// cascades of [`two_sum`], which keep the exact sum, until nothing moves) the last term
 /// carries the sign of the sum and is zero exactly when the sum is zero. The cascade is odd:
 /// negated terms give the negated result.
-#[inline(never)]
+#[inline(always)]
 pub(crate) fn exact_sum_sign<const N: usize>(mut terms: [f32; N]) -> f32 {
     // Each pass moves every non-zero remainder up past zeros and merges overlapping terms;
     // a fixed point is a non-overlapping expansion whose largest term is last. The bound only
@@ -234,6 +278,47 @@ mod tests {
             assert_eq!(got > 0.0, exact > 0.0, "{a:e} {b:e} {c:e} {d:e}");
             assert_eq!(got == 0.0, exact == 0.0, "{a:e} {b:e} {c:e} {d:e}");
             assert_eq!(exact_sum_sign([-p, -pe, q, qe]), -got);
+        }
+    }
+
+    #[test]
+    fn exact_sum_of_products_has_the_exact_sign() {
+        let mut st = 0xd1ff_0f9a_0d00_0017;
+        // Values within 2^±16 are multiples of 2^-39 below 2^17 (halved or doubled: 2^-40,
+        // 2^18): scaled by 2^40 each, the products are integers below 2^115.
+        let scale = libm::exp2(40.0);
+        let fixed = |v: f32| (v as f64 * scale) as i128;
+        for i in 0..50_000 {
+            let mut x: [f32; 6] = core::array::from_fn(|_| value(&mut st, 16));
+            let mut y: [f32; 6] = core::array::from_fn(|_| value(&mut st, 16));
+            match i % 4 {
+                // Exact cancellation: the last three products are the first three negated
+                // (some halved and doubled).
+                0 => {
+                    for k in 0..3 {
+                        (x[k + 3], y[k + 3]) = (-x[k] * 2.0, y[k] * 0.5);
+                    }
+                }
+                // Near cancellation: off by one unit in the last place of one factor.
+                1 => {
+                    for k in 0..3 {
+                        (x[k + 3], y[k + 3]) = (-x[k], y[k]);
+                    }
+                    y[5] = f32::from_bits(y[5].to_bits() + 1);
+                }
+                // Zeros, as the 2D edge function passes them.
+                2 => {
+                    for k in 2..6 {
+                        (x[k], y[k]) = (0.0, 0.0);
+                    }
+                }
+                _ => {}
+            }
+            let exact: i128 = x.iter().zip(&y).map(|(&a, &b)| fixed(a) * fixed(b)).sum();
+            let got = exact_sum_of_products(x, y);
+            assert_eq!(got > 0.0, exact > 0, "{x:?} {y:?}");
+            assert_eq!(got == 0.0, exact == 0, "{x:?} {y:?}");
+            assert_eq!(exact_sum_of_products(x.map(|v| -v), y), -got);
         }
     }
 
