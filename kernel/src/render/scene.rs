@@ -184,22 +184,35 @@ pub struct Camera {
 }
 
 /// Pixel reconstruction filter, applied by importance sampling (every sample has weight 1).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum Filter {
     /// Uniform over the pixel.
     #[default]
     Box,
     /// Triangle filter of radius one pixel.
     Tent,
+    /// Gaussian of standard deviation `sigma` pixels about the pixel centre, per axis,
+    /// truncated at `radius` pixels (a square support: the product of two truncated 1D
+    /// Gaussians).
+    Gaussian {
+        /// Standard deviation, pixels (finite, `> 0`).
+        sigma: f32,
+        /// Truncation radius, pixels (finite, `> 0`, at most [`Filter::MAX_RADIUS`]).
+        radius: f32,
+    },
 }
 
 impl Filter {
+    /// Largest Gaussian truncation radius, pixels.
+    pub const MAX_RADIUS: f32 = 16.0;
+
     /// Lower-case name as used on command lines.
     #[must_use]
     pub const fn name(self) -> &'static str {
         match self {
             Self::Box => "box",
             Self::Tent => "tent",
+            Self::Gaussian { .. } => "gaussian",
         }
     }
 }
