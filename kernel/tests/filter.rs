@@ -62,6 +62,13 @@ fn gaussian_offsets_have_the_truncated_normal_moments() {
             "σ {sigma} r {radius}: variance {var}, want {want}"
         );
     }
+    // The ends of [0, 1) stay finite and inside the radius, however wide it is against σ.
+    for (sigma, radius) in [(0.5f32, 1.5f32), (0.01, 16.0), (1e-6, 16.0), (16.0, 0.5)] {
+        for u in [0.0f32, 1.0 - f32::EPSILON / 2.0, 0.5] {
+            let x = gaussian(u, sigma, radius);
+            assert!(x.abs() < radius, "σ {sigma} r {radius} u {u}: {x}");
+        }
+    }
     // Untruncated in effect (radius 16σ): the variance is σ².
     let v: f64 = (0..N)
         .map(|i| f64::from(gaussian(((i as f64 + 0.5) / N as f64) as f32, 0.5, 8.0)).powi(2))
