@@ -74,6 +74,9 @@ pub struct BenchArgs {
     /// Skip the image-convergence renders (RMSE against time per sampler).
     #[arg(long)]
     pub no_images: bool,
+    /// Skip the path tracer against Mitsuba 3 (which needs `pip install mitsuba`).
+    #[arg(long)]
+    pub no_gi: bool,
     /// Largest sample count of the image renders (1, 2, 4, … up to it; the reference uses 16
     /// times as many) [default: 256, or 16 with --quick].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=65536))]
@@ -138,6 +141,11 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport, Error> {
         images: (!args.no_images).then(|| {
             let threads = std::thread::available_parallelism().map_or(1, usize::from);
             crate::images::ImageOptions::new(args.quick, args.image_spp, threads)
+        }),
+        gi: (!args.no_gi).then(|| {
+            let threads = std::thread::available_parallelism().map_or(1, usize::from);
+            let work = std::env::temp_dir().join("raykernel-bench-gi");
+            crate::gi::GiOptions::new(args.quick, threads, work)
         }),
         objects: args
             .objects

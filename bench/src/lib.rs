@@ -15,6 +15,7 @@
 //! - [`scale`]: the tiled scene from 10k to 1M+ triangles,
 //! - [`refit`]: refitting the trees after the mesh moved, against rebuilding them,
 //! - [`images`]: the renderer's image error against time, per sampler,
+//! - [`gi`]: the path tracer against Mitsuba 3 on a Cornell box, error against time,
 //! - [`overhead`]: the renderer against hand-written casters (the render plan's cost),
 //! - [`report`], [`figures`], [`plot`], [`stats`]: Markdown, CSV, JSON and PNG output,
 //! - [`machine`]: the machine line,
@@ -29,6 +30,7 @@ pub mod cli;
 pub mod embree;
 pub mod error;
 pub mod figures;
+pub mod gi;
 pub mod images;
 pub mod machine;
 pub mod mt;
@@ -86,6 +88,8 @@ pub struct BenchConfig {
     pub scale: scale::ScaleOptions,
     /// The image-convergence renders (`None`: skipped).
     pub images: Option<images::ImageOptions>,
+    /// The path tracer against Mitsuba 3 (`None`: skipped).
+    pub gi: Option<gi::GiOptions>,
     /// Spheres of the objects comparison (0: skipped); see [`objects`].
     pub objects: usize,
     /// `--quick` (noted in the report).
@@ -194,6 +198,11 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
         Some(opts) => images::run(opts)?,
         None => Vec::new(),
     };
+    let firefly_rows = match &config.images {
+        Some(opts) => images::fireflies(config.quick, opts.threads)?,
+        None => Vec::new(),
+    };
+    let gi_results = config.gi.as_ref().map(gi::run).transpose()?;
     machine.finish();
     let mut results = BenchResults {
         machine,
@@ -224,6 +233,8 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
         scale: scale_rows,
         refit: refit_rows,
         images: image_rows,
+        gi: gi_results,
+        fireflies: firefly_rows,
         overhead: overhead_rows,
         objects: objects_rows,
         slopes: Vec::new(),

@@ -3,7 +3,8 @@
 //! structured) and `plots/*.png`.
 
 use crate::error::Error;
-use crate::images::ImageRow;
+use crate::gi::{time_to_reach, GiResults, GiRow};
+use crate::images::{FireflyRow, ImageRow};
 use crate::machine::Machine;
 use crate::objects::ObjectsRow;
 use crate::overhead::OverheadRow;
@@ -43,6 +44,10 @@ pub struct BenchResults {
     pub refit: Vec<RefitRow>,
     /// The image-convergence renders.
     pub images: Vec<ImageRow>,
+    /// The path tracer against Mitsuba 3 (`None`: not run).
+    pub gi: Option<GiResults>,
+    /// Per-pixel error percentiles of the default scene, direct against path integrator.
+    pub fireflies: Vec<FireflyRow>,
     /// The renderer against hand-written casters.
     pub overhead: Vec<OverheadRow>,
     /// Many one-sphere objects against one object holding them.
@@ -437,6 +442,7 @@ pub fn markdown(r: &BenchResults) -> String {
     peers_section(&mut s, r);
     accuracy_section(&mut s, r);
     s.push_str(&images_section(r));
+    s.push_str(&gi_section(r.gi.as_ref()));
     refit_section(&mut s, r);
     overhead_section(&mut s, r);
     objects_section(&mut s, r);
@@ -1069,7 +1075,177 @@ pub fn images_section(r: &BenchResults) -> String {
         let _ = writeln!(s, "| {} | {:.2} |", sl.series, sl.slope);
     }
     s.push('\n');
+    fireflies_section(&mut s, &r.fireflies);
     s
+}
+
+fn fireflies_section(s: &mut String, rows: &[FireflyRow]) {
+    let Some(first) = rows.first() else {
+        return;
+    };
+    let _ = writeln!(
+        s,
+        "### Fireflies: per-pixel error of the default scene\n\n\
+         `cornell` at {}×{}, {} Sobol spp, against a {}-spp reference of the same integrator. \
+         The direct integrator reflects the small area light in the glossy sphere by sampling \
+         the lobe alone; the path integrator also samples the light at glossy vertices, \
+         weighted by MIS. Per-pixel error: RMS over the channels of the linear difference.\n",
+        first.size.0, first.size.1, first.spp, first.reference_spp
+    );
+    let _ = writeln!(
+        s,
+        "| integrator | pixels | median | 99th percentile | 99.9th percentile | largest |\n\
+         |---|---|---:|---:|---:|---:|"
+    );
+    for x in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.5} | {:.5} | {:.5} | {:.5} |",
+            x.integrator, x.region, x.median, x.p99, x.p999, x.max
+        );
+    }
+    s.push('\n');
+}
+
+/// The report's global-illumination section: our path tracer and Mitsuba 3 on one Cornell box,
+/// each image's error against both references, and the time each needs for a given error.
+#[must_use]
+pub fn gi_section(gi: Option<&GiResults>) -> String {
+    let mut s = String::from("## Global illumination: the path tracer against Mitsuba 3\n\n");
+    let Some(g) = gi else {
+        s.push_str("Not measured in this run.\n\n");
+        return s;
+    };
+    let _ = writeln!(
+        s,
+        "A Cornell box of diffuse walls and two blocks, lit through a square hole in the ceiling \
+         by a rect light, rendered by our path integrator (`f32`, paths of {} segments: the \
+         camera ray and 4 bounces) and by Mitsuba 3 (`scalar_rgb`, `path` integrator with \
+         `max_depth` {}, two-sided diffuse BSDFs, box filter) from the same scene file \
+         (`bench/scripts/mitsuba_render.py`), {}×{} pixels, single-threaded and timed at \
+         doubling sample counts. References: {} spp each (untimed, every core; ours Sobol, \
+         Mitsuba's independent).\n",
+        crate::gi::PATH_LENGTH,
+        crate::gi::PATH_LENGTH,
+        g.size.0,
+        g.size.1,
+        g.reference_spp
+    );
+    match &g.mitsuba {
+        Ok(version) => {
+            let _ = writeln!(s, "Mitsuba {version}.\n");
+        }
+        Err(why) => {
+            let _ = writeln!(
+                s,
+                "**Mitsuba did not run**: {why}. Only our renders are shown.\n"
+            );
+        }
+    }
+    if let (Some(d), Some(n)) = (g.reference_difference, g.reference_noise) {
+        let _ = writeln!(
+            s,
+            "**Same image**: the two references differ by RMSE {d:.5}; two unbiased references \
+             with their estimated noise would differ by about {n:.5} (ratio {:.2}).\n",
+            d / n
+        );
+    }
+    if g.channel_means.len() == 2 {
+        let m = &g.channel_means;
+        let _ = writeln!(
+            s,
+            "Mean radiance per channel (R, G, B): ours {:.5}, {:.5}, {:.5}; Mitsuba {:.5}, \
+             {:.5}, {:.5}.\n",
+            m[0][0], m[0][1], m[0][2], m[1][0], m[1][1], m[1][2]
+        );
+    }
+    gi_speed(&mut s, g);
+    let _ = writeln!(
+        s,
+        "| renderer | sampler | spp | render ms | RMSE vs own reference | RMSE vs the other's \
+         |\n|---|---|---:|---:|---:|---:|"
+    );
+    for x in &g.rows {
+        let other = gi_other(x).map_or("–".into(), |e| format!("{e:.5}"));
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {:.2} | {:.5} | {other} |",
+            x.renderer,
+            x.sampler,
+            x.spp,
+            x.seconds * 1e3,
+            gi_own(x).unwrap_or(f64::NAN)
+        );
+    }
+    s.push('\n');
+    s
+}
+
+/// A row's error against its own renderer's reference.
+fn gi_own(x: &GiRow) -> Option<f64> {
+    if x.renderer == "mitsuba" {
+        x.rmse_mitsuba
+    } else {
+        Some(x.rmse_ours)
+    }
+}
+
+/// A row's error against the other renderer's reference.
+fn gi_other(x: &GiRow) -> Option<f64> {
+    if x.renderer == "mitsuba" {
+        Some(x.rmse_ours)
+    } else {
+        x.rmse_mitsuba
+    }
+}
+
+/// Time to the error Mitsuba's best sampler reaches at its largest sample count.
+fn gi_speed(s: &mut String, g: &GiResults) {
+    let curve = |renderer: &str, sampler: &str| -> Vec<(f64, f64)> {
+        g.rows
+            .iter()
+            .filter(|x| x.renderer == renderer && x.sampler == sampler)
+            .filter_map(|x| Some((x.seconds, gi_own(x)?)))
+            .collect()
+    };
+    let mut samplers: Vec<(&str, &str)> = Vec::new();
+    for x in &g.rows {
+        if !samplers.contains(&(x.renderer.as_str(), x.sampler.as_str())) {
+            samplers.push((x.renderer.as_str(), x.sampler.as_str()));
+        }
+    }
+    let Some((target, their_time, their_sampler)) = samplers
+        .iter()
+        .filter(|(r, _)| *r == "mitsuba")
+        .filter_map(|(r, k)| {
+            let last = *curve(r, k).last()?;
+            Some((last.1, last.0, *k))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+    else {
+        return;
+    };
+    let _ = writeln!(
+        s,
+        "**Time to the same error**: Mitsuba's `{their_sampler}` sampler reaches RMSE \
+         {target:.5} in {:.1} ms. Ours, interpolated on log axes between measured renders:\n",
+        their_time * 1e3
+    );
+    let _ = writeln!(
+        s,
+        "| our sampler | ms to RMSE {target:.5} | ÷ Mitsuba |\n|---|---:|---:|"
+    );
+    for (r, k) in samplers.iter().filter(|(r, _)| *r == "raykernel") {
+        match time_to_reach(&curve(r, k), target) {
+            Some(t) => {
+                let _ = writeln!(s, "| {k} | {:.1} | {:.2}× |", t * 1e3, t / their_time);
+            }
+            None => {
+                let _ = writeln!(s, "| {k} | not reached | – |");
+            }
+        }
+    }
+    s.push('\n');
 }
 
 fn scale_section(s: &mut String, r: &BenchResults) {

@@ -303,6 +303,7 @@ mod tests {
             position_lines: vec![1, 2, 3, 4],
             triangles: vec![[0, 1, 2], [0, 2, 3]],
             triangle_lines: vec![5, 6],
+            ..Mesh::default()
         }
     }
 

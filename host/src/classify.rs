@@ -573,6 +573,7 @@ mod tests {
             position_lines: vec![1, 2, 3, 4],
             triangles: vec![[0, 1, 2], [1, 3, 2]],
             triangle_lines: vec![5, 6],
+            ..Mesh::default()
         };
         let down = [0.0, 0.0, 1.0];
         let eps = 1e-6f32;

@@ -19,14 +19,14 @@ use crate::render::{encode_pfm, encode_png, mode_name, plan, render, RenderError
 use crate::scene::{resolve_scene, DEFAULT_SCENE};
 use crate::scenefile::{
     filter_over, integrator_over, scene_file_text, spec_to_scene_file, FilterName, IntegratorName,
-    SamplerName,
+    SamplerName, DEFAULT_MAX_PATH_LENGTH,
 };
 use crate::spec::{eye_to_look_at, SceneOrigin, SceneSpec};
 use crate::trace::{accel_parser, trace, Builder, Mode, TraceConfig};
 use clap::builder::RangedU64ValueParser;
 use clap::{Args, CommandFactory, Parser, Subcommand};
 use raykernel::bvh::{BuildOptions, BuilderKind, DEFAULT_LEAF_SIZE, MAX_LEAF_SIZE};
-use raykernel::render::{scenes, Camera, RenderPlan, Settings};
+use raykernel::render::{scenes, Camera, Integrator, RenderPlan, SamplerKind, Settings};
 use raykernel::AccelKind;
 use raykernel::{Ray, RayError, Scalar, I16F16};
 use serde::Serialize;
@@ -589,7 +589,8 @@ pub const BUILT_IN_SPP: u32 = 64;
 pub const BUILT_IN_WIDTH: u32 = 512;
 
 /// The settings `raykernel render` uses for `spec` before command-line flags: a scene file's
-/// or an OBJ's own; for a built-in, 512 pixels wide (its aspect kept) at 64 spp.
+/// or an OBJ's own; for a built-in, 512 pixels wide (its aspect kept) at 64 Sobol samples,
+/// with the path integrator (paths of [`DEFAULT_MAX_PATH_LENGTH`] segments: indirect light).
 #[must_use]
 pub fn render_base_settings(spec: &SceneSpec) -> Settings {
     let s = spec.settings;
@@ -598,6 +599,10 @@ pub fn render_base_settings(spec: &SceneSpec) -> Settings {
             width: BUILT_IN_WIDTH,
             height: keep_aspect(BUILT_IN_WIDTH, s.height, s.width),
             spp: BUILT_IN_SPP,
+            integrator: Integrator::Path {
+                max_length: DEFAULT_MAX_PATH_LENGTH,
+            },
+            sampler: SamplerKind::Sobol,
             ..s
         },
         SceneOrigin::File(_) | SceneOrigin::Obj(_) => s,

@@ -299,6 +299,9 @@ pub fn split_by_material(spec: &mut SceneSpec, m: &MeshMaterials) {
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by_key(|&t| m.of_triangle[t]);
     spec.triangles = order.iter().map(|&t| spec.triangles[t]).collect();
+    if !spec.vertex_normals.is_empty() {
+        spec.vertex_normals = order.iter().map(|&t| spec.vertex_normals[t]).collect();
+    }
     // Only kept when one material covers the mesh: the order is then the file's.
     let source = spec
         .object_sources

@@ -2,9 +2,11 @@
 //!
 //! Accepted: `v x y z [w]` (also `v x y z r g b`, the common vertex-colour extension), and `f`
 //! with entries `v`, `v/vt`, `v//vn` or `v/vt/vn`, 1-based or negative (relative) indices.
-//! Polygons are fan-triangulated: (v0,v1,v2), (v0,v2,v3), ... `mtllib` and `usemtl` are
-//! collected by [`parse_obj_with_materials`] ([`crate::mtl`] reads the libraries). Every other
-//! statement (`vt`, `vn`, `o`, `g`, `s`, `l`, ...) is ignored, as is anything after `#`.
+//! Polygons are fan-triangulated: (v0,v1,v2), (v0,v2,v3), ... `vn x y z` normals are kept
+//! for faces whose every entry names one (smooth shading); a face with none, or with some
+//! entries lacking one, is shaded flat. `mtllib` and `usemtl` are collected by
+//! [`parse_obj_with_materials`] ([`crate::mtl`] reads the libraries). Every other statement
+//! (`vt`, `o`, `g`, `s`, `l`, ...) is ignored, as is anything after `#`.
 //!
 //! The triangle id used in hit files is the 0-based index of a triangle in this output order.
 //! A positive index may point at a vertex defined later in the file (checked once the whole file
@@ -32,6 +34,11 @@ pub struct Mesh {
     pub triangles: Vec<[u32; 3]>,
     /// The line (1-based) of the face each triangle came from.
     pub triangle_lines: Vec<usize>,
+    /// Vertex normals (`vn`), in file order.
+    pub normals: Vec<[f32; 3]>,
+    /// Per triangle, its corners' indices into `normals`, or `None` (flat). Empty when the file
+    /// has no face with normals.
+    pub triangle_normals: Vec<Option<[u32; 3]>>,
 }
 
 impl Mesh {
@@ -45,6 +52,22 @@ impl Mesh {
     #[must_use]
     pub fn triangle_f32(&self, id: usize) -> [[f32; 3]; 3] {
         self.triangles[id].map(|i| self.positions[i as usize])
+    }
+
+    /// The normals at the three corners of triangle `id` (which must be in range), zero where
+    /// the triangle is shaded flat.
+    #[must_use]
+    pub fn vertex_normals(&self, id: usize) -> [[f32; 3]; 3] {
+        match self.triangle_normals.get(id) {
+            Some(Some(corners)) => corners.map(|i| self.normals[i as usize]),
+            _ => [[0.0; 3]; 3],
+        }
+    }
+
+    /// True if some triangle has vertex normals.
+    #[must_use]
+    pub fn has_normals(&self) -> bool {
+        self.triangle_normals.iter().any(Option::is_some)
     }
 
     /// Converts every triangle to the kernel's type in mode `S`.
@@ -117,6 +140,18 @@ pub enum ObjErrorKind {
         /// Vertices available to it (defined so far for negative indices, in the file otherwise).
         vertex_count: usize,
     },
+    /// A `vn` line does not hold 3 numbers.
+    NormalArity {
+        /// Numbers found.
+        count: usize,
+    },
+    /// A normal index (`v//vn`) points outside the normal list.
+    NormalIndexOutOfRange {
+        /// The index as written.
+        index: i64,
+        /// Normals available to it (defined so far for negative indices, in the file otherwise).
+        normal_count: usize,
+    },
     /// A face with fewer than 3 vertices.
     TooFewVertices {
         /// Vertices given.
@@ -181,6 +216,16 @@ impl fmt::Display for ObjErrorKind {
             } => write!(
                 f,
                 "vertex index {index} out of range ({vertex_count} vertices available)"
+            ),
+            Self::NormalArity { count } => {
+                write!(f, "normal has {count} numbers, expected `vn x y z`")
+            }
+            Self::NormalIndexOutOfRange {
+                index,
+                normal_count,
+            } => write!(
+                f,
+                "normal index {index} out of range ({normal_count} normals available)"
             ),
             Self::TooFewVertices { count } => {
                 write!(f, "face has {count} vertices, at least 3 are needed")
@@ -283,6 +328,7 @@ pub fn parse_obj_with_materials(
     let mut mesh = Mesh::default();
     let mut materials = MaterialRefs::default();
     let mut face: Vec<u32> = Vec::new();
+    let mut face_normals: Vec<Option<u32>> = Vec::new();
     let mut line_no = 0usize;
     for raw_line in bytes.split(|&b| b == b'\n') {
         line_no += 1;
@@ -310,12 +356,30 @@ pub fn parse_obj_with_materials(
                 mesh.positions.push(xyz);
                 mesh.position_lines.push(line_no);
             }
+            Some(b"vn") => {
+                let mut xyz = [0.0f32; 3];
+                let mut count = 0usize;
+                for token in tokens {
+                    let x = parse_f32(token).map_err(|kind| err(line_no, kind))?;
+                    if let Some(slot) = xyz.get_mut(count) {
+                        *slot = x;
+                    }
+                    count += 1;
+                }
+                if count != 3 {
+                    return Err(err(line_no, ObjErrorKind::NormalArity { count }));
+                }
+                mesh.normals.push(xyz);
+            }
             Some(b"f") => {
                 face.clear();
+                face_normals.clear();
                 for token in tokens {
-                    let index = parse_face_entry(token, mesh.positions.len())
-                        .map_err(|kind| err(line_no, kind))?;
+                    let (index, normal) =
+                        parse_face_entry(token, mesh.positions.len(), mesh.normals.len())
+                            .map_err(|kind| err(line_no, kind))?;
                     face.push(index);
+                    face_normals.push(normal);
                 }
                 if face.len() < 3 {
                     return Err(err(
@@ -331,9 +395,19 @@ pub fn parse_obj_with_materials(
                         },
                     ));
                 }
+                let normals: Option<Vec<u32>> = face_normals.iter().copied().collect();
+                if normals.is_some() && mesh.triangle_normals.len() < mesh.triangles.len() {
+                    // The first face with normals: the ones before it are flat.
+                    mesh.triangle_normals.resize(mesh.triangles.len(), None);
+                }
                 for k in 1..face.len() - 1 {
                     mesh.triangles.push([face[0], face[k], face[k + 1]]);
                     mesh.triangle_lines.push(line_no);
+                    if let Some(n) = &normals {
+                        mesh.triangle_normals.push(Some([n[0], n[k], n[k + 1]]));
+                    } else if !mesh.triangle_normals.is_empty() {
+                        mesh.triangle_normals.push(None);
+                    }
                 }
             }
             Some(b"mtllib") => materials.add_libraries(tokens, line_no),
@@ -347,6 +421,19 @@ pub fn parse_obj_with_materials(
         return Err(err(last, ObjErrorKind::NoTriangles));
     }
     // Positive indices may point forward; check them now that every vertex is known.
+    let normal_count = mesh.normals.len();
+    for (tri, &line) in mesh.triangle_normals.iter().zip(&mesh.triangle_lines) {
+        let Some(tri) = tri else { continue };
+        if let Some(&bad) = tri.iter().find(|&&i| i as usize >= normal_count) {
+            return Err(err(
+                line,
+                ObjErrorKind::NormalIndexOutOfRange {
+                    index: i64::from(bad) + 1,
+                    normal_count,
+                },
+            ));
+        }
+    }
     let vertex_count = mesh.positions.len();
     for (tri, &line) in mesh.triangles.iter().zip(&mesh.triangle_lines) {
         if let Some(&bad) = tri.iter().find(|&&i| i as usize >= vertex_count) {
@@ -404,10 +491,15 @@ fn parse_index(field: &[u8], entry: &[u8]) -> Result<Option<i64>, ObjErrorKind> 
     Ok(Some(i))
 }
 
-/// One face entry (`v`, `v/vt`, `v//vn`, `v/vt/vn`) to a 0-based vertex index.
-/// Positive indices are returned unchecked (see [`parse_obj`]); negative ones are resolved
-/// against the `defined` vertices so far.
-fn parse_face_entry(entry: &[u8], defined: usize) -> Result<u32, ObjErrorKind> {
+/// One face entry (`v`, `v/vt`, `v//vn`, `v/vt/vn`) to a 0-based vertex index and, if it
+/// names one, a 0-based normal index. Positive indices are returned unchecked (see
+/// [`parse_obj`]); negative ones are resolved against the vertices (`vertices`) and normals
+/// (`normals`) defined so far.
+fn parse_face_entry(
+    entry: &[u8],
+    vertices: usize,
+    normals: usize,
+) -> Result<(u32, Option<u32>), ObjErrorKind> {
     let mut fields = entry.split(|&b| b == b'/');
     let v = fields.next().unwrap_or_default();
     let vt = fields.next().unwrap_or_default();
@@ -416,29 +508,40 @@ fn parse_face_entry(entry: &[u8], defined: usize) -> Result<u32, ObjErrorKind> {
     if fields.next().is_some() {
         return Err(bad());
     }
-    // vt and vn are not used, but must be well-formed when present.
+    // vt is not used, but must be well-formed when present.
     parse_index(vt, entry)?;
-    parse_index(vn, entry)?;
-    let index = parse_index(v, entry)?.ok_or_else(bad)?;
-    let out_of_range = |vertex_count| ObjErrorKind::IndexOutOfRange {
-        index,
-        vertex_count,
+    let normal = match parse_index(vn, entry)? {
+        None => None,
+        Some(index) => Some(zero_based(index, normals).ok_or(
+            ObjErrorKind::NormalIndexOutOfRange {
+                index,
+                normal_count: normals,
+            },
+        )?),
     };
+    let index = parse_index(v, entry)?.ok_or_else(bad)?;
+    let vertex = zero_based(index, vertices).ok_or(ObjErrorKind::IndexOutOfRange {
+        index,
+        vertex_count: vertices,
+    })?;
+    Ok((vertex, normal))
+}
+
+/// A non-zero OBJ index as a 0-based one: positive ones unchecked against `defined`, negative
+/// ones counted back from the `defined` entries so far. `None` if it cannot be an index.
+fn zero_based(index: i64, defined: usize) -> Option<u32> {
     let zero_based = if index > 0 {
         index - 1
     } else {
-        // -1 is the last vertex defined so far.
+        // -1 is the last entry defined so far.
         let back = index.unsigned_abs();
         match u64::try_from(defined) {
             Ok(d) if back <= d => (d - back) as i64,
-            _ => return Err(out_of_range(defined)),
+            _ => return None,
         }
     };
     // u32::MAX is the hit files' "miss" id, so ids stay below it.
-    match u32::try_from(zero_based) {
-        Ok(i) if i < u32::MAX => Ok(i),
-        _ => Err(out_of_range(defined)),
-    }
+    u32::try_from(zero_based).ok().filter(|&i| i < u32::MAX)
 }
 
 #[cfg(test)]
@@ -451,7 +554,7 @@ mod tests {
             "3", "3/1", "3//2", "3/1/2", "-2", "-2/1", "-2//1", "-2/-1/-1",
         ] {
             assert!(
-                matches!(parse_face_entry(entry.as_bytes(), 4), Ok(2)),
+                matches!(parse_face_entry(entry.as_bytes(), 4, 2), Ok((2, _))),
                 "{entry}"
             );
         }
@@ -464,30 +567,48 @@ mod tests {
         ] {
             assert!(
                 matches!(
-                    parse_face_entry(entry.as_bytes(), 4),
+                    parse_face_entry(entry.as_bytes(), 4, 2),
                     Err(ObjErrorKind::BadIndex { .. })
                 ),
                 "{entry}"
             );
         }
         assert!(matches!(
-            parse_face_entry(b"1/0", 4),
+            parse_face_entry(b"1/0", 4, 2),
             Err(ObjErrorKind::ZeroIndex)
         ));
         assert!(matches!(
-            parse_face_entry(b"-5", 4),
+            parse_face_entry(b"-5", 4, 2),
             Err(ObjErrorKind::IndexOutOfRange {
                 index: -5,
                 vertex_count: 4
             })
         ));
         assert!(matches!(
-            parse_face_entry(b"-9223372036854775808", 4),
+            parse_face_entry(b"-9223372036854775808", 4, 2),
             Err(ObjErrorKind::IndexOutOfRange { .. })
         ));
         assert!(matches!(
-            parse_face_entry(b"4294967296", 4),
+            parse_face_entry(b"4294967296", 4, 2),
             Err(ObjErrorKind::IndexOutOfRange { .. })
+        ));
+    }
+
+    #[test]
+    fn face_entries_name_their_normal() {
+        assert!(matches!(parse_face_entry(b"3", 4, 2), Ok((2, None))));
+        assert!(matches!(parse_face_entry(b"3/1", 4, 2), Ok((2, None))));
+        assert!(matches!(parse_face_entry(b"3//2", 4, 2), Ok((2, Some(1)))));
+        assert!(matches!(
+            parse_face_entry(b"3/1/-2", 4, 2),
+            Ok((2, Some(0)))
+        ));
+        assert!(matches!(
+            parse_face_entry(b"3//-3", 4, 2),
+            Err(ObjErrorKind::NormalIndexOutOfRange {
+                index: -3,
+                normal_count: 2
+            })
         ));
     }
 

@@ -246,6 +246,11 @@ pub fn obj_scene(path: &Path) -> Result<SceneSpec, Error> {
         transform: None,
     };
     let mut spec = lit_mesh_scene(path, triangles, source, camera);
+    if mesh.has_normals() {
+        spec.vertex_normals = (0..mesh.triangle_count())
+            .map(|i| mesh.vertex_normals(i))
+            .collect();
+    }
     if let Some(m) = crate::mtl::resolve(path, &material_refs, mesh.triangle_count())? {
         crate::mtl::split_by_material(&mut spec, &m);
     }
@@ -288,6 +293,7 @@ pub fn lit_mesh_scene(
         name,
         origin: SceneOrigin::Obj(path.to_path_buf()),
         triangles,
+        vertex_normals: Vec::new(),
         spheres: Vec::new(),
         objects: vec![ObjectData {
             shape: ShapeRange::Triangles { first: 0, count },

@@ -39,7 +39,7 @@ pub const DEFAULT_SETTINGS: Settings = Settings {
     spp: 64,
     max_depth: 4,
     integrator: Integrator::Direct,
-    sampler: SamplerKind::Stratified,
+    sampler: SamplerKind::Sobol,
     filter: Filter::Box,
     seed: 0,
 };
@@ -329,6 +329,11 @@ pub struct ObjectEntry {
     /// Triangles written out: three `[x, y, z]` corners each.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub triangles: Option<Vec<[[f32; 3]; 3]>>,
+    /// Smooth shading of `triangles`: the normals at each triangle's three corners, one entry
+    /// per triangle (all zero for a triangle shaded flat). A `mesh` takes its normals from the
+    /// OBJ file's `vn`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vertex_normals: Option<Vec<[[f32; 3]; 3]>>,
     /// Spheres.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spheres: Option<Vec<SphereEntry>>,
@@ -401,6 +406,31 @@ impl Transform {
             Some(Scale::PerAxis(s)) => s,
         };
         let mut q: [f64; 3] = std::array::from_fn(|k| f64::from(p[k]) * s[k]);
+        self.rotate(&mut q);
+        let t = self.translate.unwrap_or([0.0; 3]);
+        std::array::from_fn(|k| (q[k] + t[k]) as f32)
+    }
+
+    /// A surface normal transformed as the surface is (by the inverse transpose: the scale's
+    /// inverse, then the rotations), in `f64` and rounded to `f32` once; zero if a scale is
+    /// zero. Its length is not kept (the kernel normalises).
+    #[must_use]
+    pub fn apply_normal(&self, n: [f32; 3]) -> [f32; 3] {
+        let s = match self.scale {
+            None => [1.0; 3],
+            Some(Scale::Uniform(s)) => [s; 3],
+            Some(Scale::PerAxis(s)) => s,
+        };
+        if s.contains(&0.0) {
+            return [0.0; 3];
+        }
+        let mut q: [f64; 3] = std::array::from_fn(|k| f64::from(n[k]) / s[k]);
+        self.rotate(&mut q);
+        q.map(|x| x as f32)
+    }
+
+    /// Applies the rotations about x, then y, then z.
+    fn rotate(&self, q: &mut [f64; 3]) {
         if let Some(r) = self.rotate_deg {
             for (axis, deg) in r.iter().enumerate() {
                 let (sin, cos) = deg.to_radians().sin_cos();
@@ -411,8 +441,6 @@ impl Transform {
                 q[b] = sin * x + cos * y;
             }
         }
-        let t = self.translate.unwrap_or([0.0; 3]);
-        std::array::from_fn(|k| (q[k] + t[k]) as f32)
     }
 }
 
@@ -649,6 +677,7 @@ fn resolve(file: SceneFile, path: &Path, stem: &str) -> Result<SceneSpec, Error>
         name: file.name.clone().unwrap_or_else(|| stem.to_string()),
         origin: SceneOrigin::File(path.to_path_buf()),
         triangles: Vec::new(),
+        vertex_normals: Vec::new(),
         spheres: Vec::new(),
         objects: Vec::with_capacity(file.objects.len()),
         object_sources: Vec::with_capacity(file.objects.len()),
@@ -696,6 +725,10 @@ fn resolve(file: SceneFile, path: &Path, stem: &str) -> Result<SceneSpec, Error>
                         .push(m.triangle_f32(t).map(|p| transform.apply(p)));
                     lines.push(corners.map(|c| m.position_lines[c as usize]));
                 }
+                if m.has_normals() {
+                    let normals = (0..m.triangle_count()).map(|t| m.vertex_normals(t));
+                    add_normals(&mut spec, first_tri, normals, &transform);
+                }
                 let source = ObjectSource::Mesh {
                     path: obj_path,
                     vertex_lines: lines,
@@ -706,12 +739,32 @@ fn resolve(file: SceneFile, path: &Path, stem: &str) -> Result<SceneSpec, Error>
             (None, Some(tris), None) => {
                 spec.triangles
                     .extend(tris.iter().map(|t| t.map(|p| transform.apply(p))));
+                if let Some(normals) = &o.vertex_normals {
+                    if normals.len() != tris.len() {
+                        return Err(err(
+                            here(".vertex_normals"),
+                            format!(
+                                "{} entries for {} triangles: give one `[n0, n1, n2]` per \
+                                 triangle",
+                                normals.len(),
+                                tris.len()
+                            ),
+                        ));
+                    }
+                    add_normals(&mut spec, first_tri, normals.iter().copied(), &transform);
+                }
                 (
                     tri_range(first_tri, spec.triangles.len()),
                     ObjectSource::Inline,
                 )
             }
             (None, None, Some(spheres)) => {
+                if o.vertex_normals.is_some() {
+                    return Err(err(
+                        here(".vertex_normals"),
+                        "applies to `triangles` objects only".into(),
+                    ));
+                }
                 if o.transform.is_some() {
                     return Err(err(
                         here(".transform"),
@@ -747,7 +800,24 @@ fn resolve(file: SceneFile, path: &Path, stem: &str) -> Result<SceneSpec, Error>
         });
         spec.object_sources.push(source);
     }
+    if !spec.vertex_normals.is_empty() {
+        spec.vertex_normals
+            .resize(spec.triangles.len(), [[0.0; 3]; 3]);
+    }
     Ok(spec)
+}
+
+/// Appends the vertex normals of the triangles from `first` on, placed by `transform`; the
+/// triangles before them without normals are shaded flat (zero normals).
+fn add_normals(
+    spec: &mut SceneSpec,
+    first: usize,
+    normals: impl Iterator<Item = [[f32; 3]; 3]>,
+    transform: &Transform,
+) {
+    spec.vertex_normals.resize(first, [[0.0; 3]; 3]);
+    spec.vertex_normals
+        .extend(normals.map(|t| t.map(|n| transform.apply_normal(n))));
 }
 
 /// Indices into host vectors fit `u32` for any scene that fits in memory; saturate otherwise
@@ -876,12 +946,21 @@ pub fn to_scene_file(d: &SceneData<'_>, material_names: &[String]) -> SceneFile 
         .objects
         .iter()
         .map(|o| {
-            let (triangles, spheres) = match o.shape {
-                ShapeRange::Triangles { first, count } => (
-                    Some(d.triangles[slice(first, count, d.triangles.len())].to_vec()),
-                    None,
-                ),
+            let (triangles, vertex_normals, spheres) = match o.shape {
+                ShapeRange::Triangles { first, count } => {
+                    let normals = d
+                        .vertex_normals
+                        .get(slice(first, count, d.vertex_normals.len()))
+                        .filter(|n| n.iter().flatten().any(|c| *c != [0.0; 3]))
+                        .map(<[_]>::to_vec);
+                    (
+                        Some(d.triangles[slice(first, count, d.triangles.len())].to_vec()),
+                        normals,
+                        None,
+                    )
+                }
                 ShapeRange::Spheres { first, count } => (
+                    None,
                     None,
                     Some(
                         d.spheres[slice(first, count, d.spheres.len())]
@@ -897,6 +976,7 @@ pub fn to_scene_file(d: &SceneData<'_>, material_names: &[String]) -> SceneFile 
             ObjectEntry {
                 mesh: None,
                 triangles,
+                vertex_normals,
                 spheres,
                 transform: None,
                 material: name(o.material as usize),
@@ -996,6 +1076,7 @@ pub fn spec_to_scene_file(spec: &SceneSpec, scene_file: &Path) -> SceneFile {
         } = source
         {
             entry.triangles = None;
+            entry.vertex_normals = None;
             entry.mesh = Some(relative_path(path, scene_file));
             entry.transform = *transform;
         }

@@ -48,6 +48,8 @@ pub struct SceneSpec {
     pub origin: SceneOrigin,
     /// Every triangle; objects' ranges index into it.
     pub triangles: Vec<[[f32; 3]; 3]>,
+    /// Vertex normals: empty (flat shading) or one entry per triangle, zero for a flat one.
+    pub vertex_normals: Vec<[[f32; 3]; 3]>,
     /// Every sphere.
     pub spheres: Vec<SphereData>,
     /// Objects.
@@ -93,6 +95,7 @@ impl SceneSpec {
             name: d.name.to_string(),
             origin: SceneOrigin::BuiltIn,
             triangles: d.triangles.to_vec(),
+            vertex_normals: d.vertex_normals.to_vec(),
             spheres: d.spheres.to_vec(),
             objects: d.objects.to_vec(),
             object_sources: vec![ObjectSource::Inline; d.objects.len()],
@@ -111,6 +114,7 @@ impl SceneSpec {
         SceneData {
             name: &self.name,
             triangles: &self.triangles,
+            vertex_normals: &self.vertex_normals,
             spheres: &self.spheres,
             objects: &self.objects,
             materials: &self.materials,

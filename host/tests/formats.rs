@@ -5,10 +5,12 @@
 use clap::Parser;
 use host::cli::{run_render, Cli, Command};
 use host::obj::load_obj;
+use host::render::RenderOptions;
 use host::scene::{obj_scene, resolve_scene, OBJ_ALBEDO};
+use host::scenefile::{dump, load_scene_file, scene_file_text, spec_to_scene_file};
 use host::spec::SceneSpec;
-use raykernel::render::scenes::ShapeRange;
-use raykernel::render::Material;
+use raykernel::render::scenes::{ShapeRange, SphereData};
+use raykernel::render::{Light, Material, Settings};
 use std::path::{Path, PathBuf};
 
 fn repo(rel: &str) -> PathBuf {
@@ -173,6 +175,158 @@ fn faces_before_the_first_usemtl_are_white_and_bad_references_name_their_line() 
     let e = obj_scene(&path).unwrap_err().to_string();
     assert!(
         e.contains("bad.mtl:2: `Kd` values must lie in [0, 1]"),
+        "{e}"
+    );
+}
+
+// --- smooth shading from `vn` ------------------------------------------------------------
+
+/// An icosphere of `levels` subdivisions as OBJ text, with its unit positions as `vn` normals
+/// when `normals`.
+fn icosphere_obj(levels: u32, normals: bool) -> String {
+    let (positions, faces) = host::mesh::unit_icosphere(levels);
+    let mut text = String::new();
+    for p in &positions {
+        text.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2]));
+        if normals {
+            text.push_str(&format!("vn {} {} {}\n", p[0], p[1], p[2]));
+        }
+    }
+    for f in &faces {
+        let [a, b, c] = f.map(|i| i + 1);
+        if normals {
+            text.push_str(&format!("f {a}//{a} {b}//{b} {c}//{c}\n"));
+        } else {
+            text.push_str(&format!("f {a} {b} {c}\n"));
+        }
+    }
+    text
+}
+
+fn render_linear(spec: &SceneSpec, settings: Settings) -> Vec<[f32; 3]> {
+    let options = RenderOptions {
+        threads: 2,
+        ..RenderOptions::default()
+    };
+    match host::render::render(&spec.data(), settings, &options) {
+        Ok(r) => r.frame.linear,
+        Err(e) => panic!("render failed: {e:?}"),
+    }
+}
+
+/// An icosphere with its `vn` normals renders as the sphere it approximates: inside the
+/// silhouette, its image is much closer to an exact sphere's than the flat-shaded (faceted)
+/// mesh's is.
+#[test]
+fn obj_vertex_normals_render_without_facets() {
+    let dir = temp_dir("smooth");
+    let (smooth_obj, flat_obj) = (dir.join("smooth.obj"), dir.join("flat.obj"));
+    std::fs::write(&smooth_obj, icosphere_obj(3, true)).unwrap();
+    std::fs::write(&flat_obj, icosphere_obj(3, false)).unwrap();
+    let smooth = obj_scene(&smooth_obj).unwrap();
+    let flat = obj_scene(&flat_obj).unwrap();
+    assert_eq!(smooth.triangles, flat.triangles);
+    assert_eq!(smooth.vertex_normals.len(), smooth.triangles.len());
+    assert!(flat.vertex_normals.is_empty());
+    // The exact sphere under the same camera and lights.
+    // One point light, one sample at each pixel's centre: no noise, only shading differs.
+    let lights = vec![Light::Point {
+        position: [3.0, 4.0, 5.0],
+        intensity: [40.0; 3],
+    }];
+    let (mut smooth, mut flat) = (smooth, flat);
+    smooth.lights.clone_from(&lights);
+    flat.lights = lights;
+    let mut sphere = flat.clone();
+    sphere.spheres = vec![SphereData {
+        center: [0.0; 3],
+        radius: 1.0,
+    }];
+    sphere.objects[0].shape = ShapeRange::Spheres { first: 0, count: 1 };
+    let settings = Settings {
+        width: 96,
+        height: 96,
+        spp: 1,
+        ..flat.settings
+    };
+    let images = [&smooth, &flat, &sphere].map(|s| render_linear(s, settings));
+    let background = flat.background;
+    let (w, h) = (96usize, 96usize);
+    // Pixels inside every silhouette: the pixel and its four neighbours show the object.
+    let on_object = |x: usize, y: usize| images.iter().all(|im| im[y * w + x] != background);
+    let interior: Vec<usize> = (1..h - 1)
+        .flat_map(|y| (1..w - 1).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            on_object(x, y)
+                && on_object(x - 1, y)
+                && on_object(x + 1, y)
+                && on_object(x, y - 1)
+                && on_object(x, y + 1)
+        })
+        .map(|(x, y)| y * w + x)
+        .collect();
+    assert!(interior.len() > 1500, "{} interior pixels", interior.len());
+    let error = |im: &[[f32; 3]]| {
+        interior
+            .iter()
+            .map(|&i| {
+                (0..3)
+                    .map(|c| f64::from((im[i][c] - images[2][i][c]).abs()))
+                    .sum::<f64>()
+            })
+            .sum::<f64>()
+            / interior.len() as f64
+    };
+    let (smooth_error, flat_error) = (error(&images[0]), error(&images[1]));
+    assert!(
+        smooth_error < 0.3 * flat_error,
+        "mean error against the exact sphere: smooth {smooth_error}, flat {flat_error}"
+    );
+}
+
+/// Normals survive a scene dump: a mesh object names its OBJ file (the normals come from its
+/// `vn` again), inline triangles carry `vertex_normals`; both load to the same scene.
+#[test]
+fn vertex_normals_survive_a_scene_dump() {
+    let dir = temp_dir("smooth_dump");
+    let obj = dir.join("ball.obj");
+    std::fs::write(&obj, icosphere_obj(1, true)).unwrap();
+    let spec = obj_scene(&obj).unwrap();
+    let file = dir.join("ball.json");
+    let text = scene_file_text(&spec_to_scene_file(&spec, &file));
+    assert!(text.contains("\"mesh\""), "{text}");
+    std::fs::write(&file, &text).unwrap();
+    assert_eq!(
+        load_scene_file(&file).unwrap().vertex_normals,
+        spec.vertex_normals
+    );
+    let inline = dir.join("inline.json");
+    let text = dump(&spec.data(), &spec.material_names);
+    assert!(text.contains("\"vertex_normals\""));
+    std::fs::write(&inline, &text).unwrap();
+    let back = load_scene_file(&inline).unwrap();
+    assert_eq!(back.vertex_normals, spec.vertex_normals);
+    assert_eq!(back.triangles, spec.triangles);
+}
+
+#[test]
+fn inline_vertex_normals_need_one_entry_per_triangle() {
+    let dir = temp_dir("smooth_inline");
+    let file = dir.join("bad.json");
+    let text = r#"{
+        "format": "raykernel-scene", "version": 1,
+        "camera": {"eye": [0, 0, 5], "look_at": [0, 0, 0], "up": [0, 1, 0],
+                   "vfov_deg": 40, "aperture_radius": 0, "focus_distance": 5},
+        "materials": [{"name": "white", "diffuse": {"albedo": [0.8, 0.8, 0.8]}}],
+        "objects": [{"material": "white",
+                     "triangles": [[[0, 0, 0], [1, 0, 0], [0, 1, 0]]],
+                     "vertex_normals": []}],
+        "lights": []
+    }"#;
+    std::fs::write(&file, text).unwrap();
+    let e = load_scene_file(&file).unwrap_err().to_string();
+    assert!(
+        e.contains("objects[0].vertex_normals: 0 entries for 1 triangles"),
         "{e}"
     );
 }

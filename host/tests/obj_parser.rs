@@ -38,10 +38,63 @@ fn every_face_entry_form_gives_the_same_triangle() {
         "f -4/-1/-1 -3/-1/-1 -2/-1/-1",
         "f 1/1 -3//2 3/3/3",
     ] {
-        let m = mesh(&format!("{QUAD}{face}\n"));
+        let m = mesh(&format!("{QUAD}vn 0 0 1\nvn 0 1 0\nvn 1 0 0\n{face}\n"));
         assert_eq!(m.triangles, vec![[0, 1, 2]], "{face}");
-        assert_eq!(m.triangle_lines, vec![5], "{face}");
+        assert_eq!(m.triangle_lines, vec![8], "{face}");
     }
+}
+
+#[test]
+fn faces_keep_their_vertex_normals() {
+    let normals = "vn 0 0 1\nvn 0 1 0\nvn 1 0 0\n";
+    // A face without normals before the first with them, a quad with them (both fan
+    // triangles), and one whose entries name normals only in part (flat).
+    let m = mesh(&format!(
+        "{QUAD}{normals}f 1 2 3\nf 1//3 2//2 3//1 4//-1\nf 1//1 2 3\n"
+    ));
+    assert_eq!(
+        m.normals,
+        vec![[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]
+    );
+    assert_eq!(
+        m.triangle_normals,
+        vec![None, Some([2, 1, 0]), Some([2, 0, 2]), None]
+    );
+    assert_eq!(m.vertex_normals(0), [[0.0; 3]; 3]);
+    assert_eq!(
+        m.vertex_normals(1),
+        [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    );
+    assert!(m.has_normals());
+    assert!(!mesh(&format!("{QUAD}{normals}f 1 2 3\n")).has_normals());
+}
+
+#[test]
+fn bad_vertex_normals_name_their_line() {
+    let e = error(&format!("{QUAD}vn 0 1\nf 1 2 3\n"));
+    assert_eq!(e.line, Some(5));
+    assert!(
+        matches!(e.kind, ObjErrorKind::NormalArity { count: 2 }),
+        "{e}"
+    );
+    let e = error(&format!("{QUAD}vn 0 1 0\nf 1//1 2//2 3//1\n"));
+    assert_eq!(e.line, Some(6));
+    assert!(
+        matches!(
+            e.kind,
+            ObjErrorKind::NormalIndexOutOfRange {
+                index: 2,
+                normal_count: 1
+            }
+        ),
+        "{e}"
+    );
+    let e = error(&format!("{QUAD}f 1//-1 2//-1 3//-1\n"));
+    assert!(
+        e.to_string()
+            .contains("normal index -1 out of range (0 normals available)"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -104,11 +104,12 @@ fn default_scene_renders_in_both_modes_from_the_command_line() {
         assert_eq!(v["camera_rays"], 32 * 24 * 2);
         assert!(v["shadow_rays"].as_u64().unwrap() > 0);
         assert!(v["reflection_rays"].as_u64().unwrap() > 0);
+        // Built-in scenes render with the path integrator (indirect light) by default.
         for effect in [
             "depth of field on",
             "motion blur on",
             "soft shadows on",
-            "glossy on",
+            "path tracing (max length 5 segments",
         ] {
             assert!(v["plan"].as_str().unwrap().contains(effect), "{effect}");
         }
@@ -134,8 +135,8 @@ fn explain_prints_the_plan_without_rendering() {
     assert_eq!(
         lines[0],
         "plan: anti-aliasing on (64 spp, sobol, tent filter); depth of field off; motion blur \
-         off; lights: 2 point, 0 area (soft shadows off); reflections on (glossy off, max \
-         depth 3)"
+         off; lights: 2 point, 0 area (soft shadows off); path tracing (max length 5 segments, \
+         Russian roulette after 3, light and BSDF sampling with MIS)"
     );
     let v: serde_json::Value = serde_json::from_str(lines[1]).unwrap();
     assert_eq!(

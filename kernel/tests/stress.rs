@@ -1,4 +1,4 @@
-//! Numerical stability stress suite (issue 6): counts leaks, false hits (self-hits of spawned
+//! Numerical stability stress suite: counts leaks, false hits (self-hits of spawned
 //! rays, hits on zero-area triangles) and mismatches (BVH builders vs each other and vs brute
 //! force, `occluded` vs `intersect`, wrong or missing typed errors, panics) per ray class, in
 //! both number modes, with a Möller–Trumbore contrast column (test-only code, not the kernel).

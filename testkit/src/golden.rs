@@ -360,6 +360,7 @@ pub const CORNELL_PATH: SceneData<'static> = SceneData {
 pub const EMITTERS: SceneData<'static> = SceneData {
     name: "emitters",
     triangles: &EMITTERS_TRIANGLES,
+    vertex_normals: &[],
     spheres: &[
         SphereData {
             center: [-0.4, 0.3, 0.1],

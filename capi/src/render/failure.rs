@@ -76,7 +76,7 @@ pub(super) fn status_of(e: &SceneError, sphere: bool) -> RkStatus {
         Problem::Build(BuildError::BadPrimitive { .. }) => RkStatus::ErrBadTriangle,
         Problem::Build(BuildError::TooManyPrims { .. }) => RkStatus::ErrTooLarge,
         Problem::Build(BuildError::ArenaTooSmall { .. }) => RkStatus::ErrMemoryTooSmall,
-        Problem::Build(_) | Problem::NotLinked => RkStatus::ErrBadArgument,
+        Problem::Build(_) | Problem::NotLinked | Problem::Length { .. } => RkStatus::ErrBadArgument,
     }
 }
 

@@ -101,6 +101,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
                 return Err(err(i, "motion", Problem::NonFinite));
             }
             super::scene::check_rgb(o.emission, false).map_err(|p| err(i, "emission", p))?;
+            check_vertex_normals(o).map_err(|p| err(i, "vertex_normals", p))?;
             let bounds = match o.shape {
                 Shape::Triangles(t) => union_bounds(t),
                 Shape::Spheres(s) if F::SPHERES => union_bounds(s),
@@ -128,6 +129,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
                 one_sided: o.one_sided,
                 emitted,
                 emitter_base,
+                vertex_normals: o.vertex_normals,
                 motion,
                 swept,
             };
@@ -349,9 +351,16 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
                 let p: [f64; 3] = core::array::from_fn(|k| {
                     v[0][k] + u * (v[1][k] - v[0][k]) + w * (v[2][k] - v[0][k]) + d[k]
                 });
+                let n = triangle_normal(&v, ray);
+                let shading = o
+                    .vertex_normals
+                    .get(local as usize)
+                    .and_then(|corners| interpolated_normal(corners, u, w, &n))
+                    .unwrap_or(n);
                 Some(SurfacePoint {
                     position: p,
-                    normal: triangle_normal(&v, ray),
+                    normal: n.map(|x| x as f32),
+                    shading: shading.map(|x| x as f32),
                     prim: Prim::Triangle(tri, hu, hv),
                     shift: d,
                 })
@@ -366,6 +375,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
                 Some(SurfacePoint {
                     position: p,
                     normal: n.map(|x| x as f32),
+                    shading: n.map(|x| x as f32),
                     prim: Prim::Sphere(sp),
                     shift: d,
                 })
@@ -387,7 +397,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
             // A translation does not turn a triangle: no motion needed.
             Shape::Triangles(t) => {
                 let v = t.get(local as usize)?.v.map(|p| p.map(S::to_f64));
-                Some(triangle_normal(&v, ray))
+                Some(triangle_normal(&v, ray).map(|x| x as f32))
             }
             Shape::Spheres(s) if F::SPHERES => {
                 let d = o.motion.map_or([0.0; 3], |m| displacement::<S>(m, time));
@@ -400,10 +410,9 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
 }
 
 /// A triangle's unit geometric normal `(v1 − v0) × (v2 − v0)` (degenerate: against the ray).
-fn triangle_normal<S: SpawnScalar>(v: &[[f64; 3]; 3], ray: &Ray<S>) -> [f32; 3] {
+fn triangle_normal<S: SpawnScalar>(v: &[[f64; 3]; 3], ray: &Ray<S>) -> [f64; 3] {
     unit(cross(&sub(&v[1], &v[0]), &sub(&v[2], &v[0])))
         .unwrap_or_else(|| S::ray_dir(ray.data()).map(|x| -x.to_f64()))
-        .map(|x| x as f32)
 }
 
 /// A sphere's unit outward normal at the ray's hit `t`, the sphere displaced by `d` (the hit
@@ -435,6 +444,52 @@ pub(super) fn emitted_by<S: Scalar>(
             s
         }
     })
+}
+
+/// The unit shading normal at barycentrics `(u, w)` (weights of the second and third corner):
+/// the corners' unit normals blended and normalised, turned to the side of the unit geometric
+/// normal `geometric`. `None` when the corners' normals are zero or blend to zero.
+fn interpolated_normal(
+    corners: &[[f32; 3]; 3],
+    u: f64,
+    w: f64,
+    geometric: &[f64; 3],
+) -> Option<[f64; 3]> {
+    let weights = [1.0 - u - w, u, w];
+    let mut blend = [0.0f64; 3];
+    for (corner, weight) in corners.iter().zip(weights) {
+        if let Some(c) = unit(corner.map(f64::from)) {
+            for (b, x) in blend.iter_mut().zip(c) {
+                *b += weight * x;
+            }
+        }
+    }
+    let s = unit(blend)?;
+    let toward = s[0] * geometric[0] + s[1] * geometric[1] + s[2] * geometric[2];
+    Some(if toward < 0.0 { s.map(|x| -x) } else { s })
+}
+
+/// Vertex normals: none, or one finite triple per triangle of a triangle shape.
+fn check_vertex_normals<S: Scalar>(o: &Object<'_, S>) -> Result<(), Problem> {
+    if o.vertex_normals.is_empty() {
+        return Ok(());
+    }
+    let expected = match o.shape {
+        Shape::Triangles(t) => t.len(),
+        Shape::Spheres(_) => 0,
+    };
+    if o.vertex_normals.len() != expected {
+        return Err(Problem::Length { expected });
+    }
+    if o.vertex_normals
+        .iter()
+        .flatten()
+        .all(|n| super::scene::finite3(*n))
+    {
+        Ok(())
+    } else {
+        Err(Problem::NonFinite)
+    }
 }
 
 fn union_bounds<S: Scalar, P: Primitive<S>>(prims: &[P]) -> Option<Aabb<S>> {

@@ -74,13 +74,13 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
             break;
         };
         let dir_unit = unit_at(dir, depth);
-        let n = Vec3::from_array(sp.normal);
-        // Two-sided surfaces: shade with the normal facing the incoming ray.
-        let nf = if n.dot(dir_unit) > 0.0 { -n } else { n };
+        // Two-sided surfaces: shade with the normals facing the incoming ray.
+        let facing = sp.facing(dir_unit);
+        let nf = facing.shading;
         match material {
             Material::Emissive { .. } => break, // ended the path above
             Material::Diffuse { albedo } => {
-                let e = light_sum(r, &sp, nf, Lobe::Diffuse, false, time, stream, stats);
+                let e = light_sum(r, &sp, facing, Lobe::Diffuse, false, time, stream, stats);
                 radiance += throughput * Vec3::from_array(*albedo) * (e * FRAC_1_PI);
                 break;
             }
@@ -88,8 +88,11 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
                 if depth >= plan.max_depth {
                     break;
                 }
-                throughput *= Vec3::from_array(*reflectance);
                 dir = reflect(dir_unit, nf);
+                if !facing.leaves(dir) {
+                    break;
+                }
+                throughput *= Vec3::from_array(*reflectance);
             }
             Material::Glossy {
                 reflectance,
@@ -100,7 +103,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
                 }
                 let (a, b) = stream.next_2d();
                 let lobe = to_world(phong_lobe(a, b, *exponent), reflect(dir_unit, nf));
-                if lobe.dot(nf) <= 0.0 {
+                if lobe.dot(nf) <= 0.0 || !facing.leaves(lobe) {
                     break;
                 }
                 throughput *= Vec3::from_array(*reflectance);

@@ -7,7 +7,7 @@ use super::geometry::Geometry;
 use super::lights::LightGeom;
 use super::sampling::{power_heuristic, to_world, uniform_cone, SampleStream};
 use super::scene::Light;
-use super::surface::{dir_in_mode, SurfacePoint};
+use super::surface::{dir_in_mode, Facing, SurfacePoint};
 use super::{RenderStats, Renderer};
 use crate::accel::{AccelFamily, NoStats};
 use crate::geom::spawn::{shadow_t_max, SpawnScalar};
@@ -58,7 +58,7 @@ pub(super) fn phong_density(c: f32, exponent: f32) -> f32 {
     }
 }
 
-/// `Σ L·w·G / pdf` over every light at a shading point with facing normal `nf`, one sample
+/// `Σ L·w·G / pdf` over every light at a shading point with normals `facing`, one sample
 /// per area light, each tested by a shadow ray; `w` is the [`Lobe`]'s weight. With `mis`, area
 /// lights' samples carry the power heuristic's weight against BSDF sampling (point lights,
 /// which BSDF sampling cannot reach, weight 1); without it every sample weighs 1.
@@ -71,13 +71,14 @@ pub(super) fn phong_density(c: f32, exponent: f32) -> f32 {
 pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
     r: &Renderer<'_, S, F>,
     sp: &SurfacePoint<'_, S>,
-    nf: Vec3,
+    facing: Facing,
     lobe: Lobe,
     mis: bool,
     time: f32,
     stream: &mut SampleStream,
     stats: &mut RenderStats,
 ) -> Vec3 {
+    let nf = facing.shading;
     let p = sp.position;
     let pf = Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
     let mut sum = Vec3::ZERO;
@@ -161,7 +162,7 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
                 ((pf + wi * t).to_array(), c)
             }
         };
-        if contribution == Vec3::ZERO {
+        if contribution == Vec3::ZERO || !facing.leaves(Vec3::from_array(target) - pf) {
             continue;
         }
         stats.shadow_rays += 1;

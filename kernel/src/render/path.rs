@@ -125,9 +125,9 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
         let Some(sp) = r.geometry.surface_point(ray, &hit, time) else {
             break;
         };
-        let n = Vec3::from_array(sp.normal);
-        // Two-sided surfaces: shade with the normal facing the incoming ray.
-        let nf = if n.dot(dir) > 0.0 { -n } else { n };
+        // Two-sided surfaces: shade with the normals facing the incoming ray.
+        let facing = sp.facing(dir);
+        let nf = facing.shading;
         // Multiple importance sampling unless the BSDF ray is the path's last segment.
         let mis = segments + 1 < max_length;
         let p = sp.position;
@@ -136,12 +136,12 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
             Material::Emissive { .. } => break, // ended the path above
             Material::Diffuse { albedo } => {
                 let albedo = Vec3::from_array(*albedo);
-                let e = light_sum(r, &sp, nf, Lobe::Diffuse, mis, time, stream, stats);
+                let e = light_sum(r, &sp, facing, Lobe::Diffuse, mis, time, stream, stats);
                 radiance += throughput * albedo * (e * FRAC_1_PI);
                 let (a, b) = stream.next_2d();
                 let wi = to_world(cosine_hemisphere(a, b), nf);
                 let cos = wi.dot(nf);
-                if cos <= 0.0 || cos.is_nan() {
+                if cos <= 0.0 || cos.is_nan() || !facing.leaves(wi) {
                     break;
                 }
                 throughput *= albedo;
@@ -157,19 +157,23 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
                     mirror,
                     exponent: *exponent,
                 };
-                let e = light_sum(r, &sp, nf, lobe, mis, time, stream, stats);
+                let e = light_sum(r, &sp, facing, lobe, mis, time, stream, stats);
                 radiance += throughput * reflectance * e;
                 let (a, b) = stream.next_2d();
                 let wi = to_world(phong_lobe(a, b, *exponent), mirror).normalize_or_zero();
-                if wi.dot(nf) <= 0.0 {
+                if wi.dot(nf) <= 0.0 || !facing.leaves(wi) {
                     break;
                 }
                 throughput *= reflectance;
                 (wi, Some(phong_density(wi.dot(mirror), *exponent)))
             }
             Material::Mirror { reflectance } => {
+                let wi = reflect(dir, nf);
+                if !facing.leaves(wi) {
+                    break;
+                }
                 throughput *= Vec3::from_array(*reflectance);
-                (reflect(dir, nf), None)
+                (wi, None)
             }
         };
         // The BSDF direction and its density (`None`: a mirror's, a delta).

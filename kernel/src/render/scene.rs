@@ -102,6 +102,11 @@ pub struct Object<'a, S: Scalar> {
     /// black, and it blocks light from both sides. `false` (two-sided, the default): both
     /// sides reflect and emit alike.
     pub one_sided: bool,
+    /// Smooth shading: for each triangle of a [`Shape::Triangles`] shape, the normals at its
+    /// three vertices (any length; interpolated by the hit's barycentrics and normalised), or
+    /// empty for flat shading. A triangle whose normals are all zero is shaded flat. The
+    /// geometric normal still decides offsets, sidedness and which directions leave the surface.
+    pub vertex_normals: &'a [[[f32; 3]; 3]],
 }
 
 impl<'a, S: Scalar> Object<'a, S> {
@@ -114,6 +119,7 @@ impl<'a, S: Scalar> Object<'a, S> {
             motion: [0.0; 3],
             emission: [0.0; 3],
             one_sided: false,
+            vertex_normals: &[],
         }
     }
     /// True if the object moves during the shutter interval.
@@ -367,6 +373,11 @@ pub enum Problem {
     },
     /// A primitive could not be built into the accelerator.
     Build(crate::accel::BuildError),
+    /// A list whose length must be `expected` (for example one entry per triangle).
+    Length {
+        /// The length required.
+        expected: usize,
+    },
     /// A part of the renderer this build leaves out: a kind of primitive the accelerator
     /// family does not link ([`crate::AccelFamily::SPHERES`]), or [`Integrator::Path`] without
     /// the kernel's `path-tracing` feature.
@@ -419,6 +430,7 @@ impl fmt::Display for Problem {
             Self::TooSmall { needed, available } => {
                 write!(f, "buffer too small: need {needed} slots, have {available}")
             }
+            Self::Length { expected } => write!(f, "must have {expected} entries"),
             Self::Build(e) => write!(f, "{e}"),
             Self::NotLinked => write!(f, "this renderer is built without it"),
         }

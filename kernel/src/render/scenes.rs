@@ -60,6 +60,9 @@ pub struct SceneData<'d> {
     pub name: &'d str,
     /// Every triangle, objects' ranges index into it.
     pub triangles: &'d [[[f32; 3]; 3]],
+    /// Vertex normals per triangle ([`Object::vertex_normals`]): empty (flat shading) or one
+    /// entry per triangle, all zero for a triangle shaded flat.
+    pub vertex_normals: &'d [[[f32; 3]; 3]],
     /// Every sphere.
     pub spheres: &'d [SphereData],
     /// Objects.
@@ -192,14 +195,18 @@ impl<'d> SceneData<'d> {
                     Ok(a..b)
                 }
             };
-            let shape = match o.shape {
+            let (shape, vertex_normals) = match o.shape {
                 ShapeRange::Triangles { first, count } => {
                     let r = range(first, count, triangles.len())?;
-                    Shape::Triangles(triangles.get(r).unwrap_or_default())
+                    let normals = self.vertex_normals.get(r.clone()).unwrap_or_default();
+                    (
+                        Shape::Triangles(triangles.get(r).unwrap_or_default()),
+                        normals,
+                    )
                 }
                 ShapeRange::Spheres { first, count } => {
                     let r = range(first, count, spheres.len())?;
-                    Shape::Spheres(spheres.get(r).unwrap_or_default())
+                    (Shape::Spheres(spheres.get(r).unwrap_or_default()), &[][..])
                 }
             };
             *slot = Object {
@@ -208,6 +215,7 @@ impl<'d> SceneData<'d> {
                 motion: o.motion,
                 emission: o.emission,
                 one_sided: o.one_sided,
+                vertex_normals,
             };
         }
         let n = self.objects.len();
@@ -424,6 +432,7 @@ const CORNELL_LIGHTS: [Light; 1] = [Light::Rect {
 pub const CORNELL: SceneData<'static> = SceneData {
     name: "cornell",
     triangles: &CORNELL_TRIANGLES,
+    vertex_normals: &[],
     spheres: &CORNELL_SPHERES,
     objects: &CORNELL_OBJECTS,
     materials: &CORNELL_MATERIALS,
@@ -511,6 +520,7 @@ const SPHERES_LIGHTS: [Light; 2] = [
 pub const SPHERES: SceneData<'static> = SceneData {
     name: "spheres",
     triangles: &SPHERES_TRIANGLES,
+    vertex_normals: &[],
     spheres: &SPHERES_SPHERES,
     objects: &SPHERES_OBJECTS,
     materials: &SPHERES_MATERIALS,
@@ -642,6 +652,7 @@ const MOTION_LIGHTS: [Light; 2] = [
 pub const MOTION: SceneData<'static> = SceneData {
     name: "motion",
     triangles: &MOTION_TRIANGLES,
+    vertex_normals: &[],
     spheres: &MOTION_SPHERES,
     objects: &MOTION_OBJECTS,
     materials: &MOTION_MATERIALS,

@@ -5,6 +5,7 @@ use super::motion::shifted;
 use crate::geom::spawn::{self, sub, SpawnScalar, MAX_NUDGES};
 use crate::geom::{Sphere, Triangle};
 use crate::scalar::Scalar;
+use glam::Vec3;
 
 /// Spheres leave their surface this many times the triangle rule's offset (the sphere test
 /// solves a quadratic: its roots near the surface carry more rounding than a plane's).
@@ -24,9 +25,51 @@ pub(crate) struct SurfacePoint<'a, S: Scalar> {
     pub(crate) position: [f64; 3],
     /// Unit geometric normal (triangles: `(v1−v0)×(v2−v0)`; spheres: outward).
     pub(crate) normal: [f32; 3],
+    /// Unit shading normal, on the geometric normal's side: interpolated from
+    /// [`super::Object::vertex_normals`], else the geometric normal itself.
+    pub(crate) shading: [f32; 3],
     pub(super) prim: Prim<'a, S>,
     /// The object's displacement at the ray's time (zero when static).
     pub(super) shift: [f64; 3],
+}
+
+/// The normals at a surface point, both turned to face the ray that arrived there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Facing {
+    /// Geometric normal: which directions leave the surface on the arriving ray's side.
+    pub(crate) geometric: Vec3,
+    /// Shading normal: cosines, reflection and BSDF sampling.
+    pub(crate) shading: Vec3,
+}
+
+impl Facing {
+    /// True if a ray along `dir` leaves the surface on the arriving side, as far as shading
+    /// needs to check: with flat shading every direction shading accepts does (its cosine test
+    /// is the same one); with smooth shading the geometric side is tested too.
+    #[inline(always)]
+    pub(crate) fn leaves(&self, dir: Vec3) -> bool {
+        self.shading == self.geometric || self.geometric.dot(dir) > 0.0
+    }
+}
+
+impl<S: Scalar> SurfacePoint<'_, S> {
+    /// The normals facing a ray arriving along `dir`.
+    #[inline(always)]
+    pub(crate) fn facing(&self, dir: Vec3) -> Facing {
+        let n = Vec3::from_array(self.normal);
+        let s = Vec3::from_array(self.shading);
+        if n.dot(dir) > 0.0 {
+            Facing {
+                geometric: -n,
+                shading: -s,
+            }
+        } else {
+            Facing {
+                geometric: n,
+                shading: s,
+            }
+        }
+    }
 }
 
 impl<S: SpawnScalar> SurfacePoint<'_, S> {
