@@ -172,7 +172,7 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
     }
     if r.plan.emissive_geometry {
         if let Some(s) = emitters::sample(r, pf, nf, lobe, mis, time, stream) {
-            if s.contribution != Vec3::ZERO {
+            if s.contribution != Vec3::ZERO && facing.leaves(Vec3::from_array(s.target) - pf) {
                 stats.shadow_rays += 1;
                 if visible(r, sp, s.target, time, true) {
                     sum += s.contribution;
