@@ -18,8 +18,8 @@ use crate::rayfile::{read_hits, read_rays, write_hits, RayRecord};
 use crate::render::{encode_pfm, encode_png, mode_name, plan, render, RenderError, RenderOptions};
 use crate::scene::{resolve_scene, DEFAULT_SCENE};
 use crate::scenefile::{
-    integrator_over, scene_file_text, spec_to_scene_file, FilterName, IntegratorName, SamplerName,
-    DEFAULT_MAX_PATH_LENGTH,
+    filter_over, integrator_over, scene_file_text, spec_to_scene_file, FilterName, IntegratorName,
+    SamplerName, DEFAULT_MAX_PATH_LENGTH,
 };
 use crate::spec::{eye_to_look_at, SceneOrigin, SceneSpec};
 use crate::trace::{accel_parser, trace, Builder, Mode, TraceConfig};
@@ -112,6 +112,12 @@ pub struct SettingsArgs {
     /// Pixel filter [default: the scene's].
     #[arg(long, value_enum)]
     pub filter: Option<FilterName>,
+    /// Gaussian filter: standard deviation in pixels [default: the scene's, else 0.5].
+    #[arg(long)]
+    pub filter_sigma: Option<f32>,
+    /// Gaussian filter: truncation radius in pixels [default: the scene's, else 1.5].
+    #[arg(long)]
+    pub filter_radius: Option<f32>,
     /// Seed of every random value [default: the scene's].
     #[arg(long)]
     pub seed: Option<u32>,
@@ -144,7 +150,12 @@ impl SettingsArgs {
             max_depth: self.max_depth.unwrap_or(base.max_depth),
             integrator: integrator_over(self.integrator, self.max_path_length, base.integrator),
             sampler: self.sampler.map_or(base.sampler, Into::into),
-            filter: self.filter.map_or(base.filter, Into::into),
+            filter: filter_over(
+                self.filter,
+                self.filter_sigma,
+                self.filter_radius,
+                base.filter,
+            ),
             seed: self.seed.unwrap_or(base.seed),
         }
     }

@@ -129,6 +129,12 @@ pub struct SettingsEntry {
     /// Pixel filter.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub filter: Option<FilterName>,
+    /// Gaussian filter: standard deviation, pixels.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filter_sigma: Option<f32>,
+    /// Gaussian filter: truncation radius, pixels.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filter_radius: Option<f32>,
     /// Seed of every random value.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seed: Option<u32>,
@@ -216,15 +222,8 @@ pub enum FilterName {
     Box,
     /// Triangle of radius one pixel.
     Tent,
-}
-
-impl From<FilterName> for Filter {
-    fn from(f: FilterName) -> Self {
-        match f {
-            FilterName::Box => Self::Box,
-            FilterName::Tent => Self::Tent,
-        }
-    }
+    /// Truncated Gaussian (`filter_sigma`, `filter_radius`).
+    Gaussian,
 }
 
 impl From<Filter> for FilterName {
@@ -232,7 +231,37 @@ impl From<Filter> for FilterName {
         match f {
             Filter::Box => Self::Box,
             Filter::Tent => Self::Tent,
+            Filter::Gaussian { .. } => Self::Gaussian,
         }
+    }
+}
+
+/// The Gaussian filter's standard deviation when none is given, pixels.
+pub const DEFAULT_FILTER_SIGMA: f32 = 0.5;
+/// The Gaussian filter's truncation radius when none is given, pixels.
+pub const DEFAULT_FILTER_RADIUS: f32 = 1.5;
+
+/// The filter `name`, `sigma` and `radius` ask for over `base` (each `None` keeps `base`'s; a
+/// Gaussian named over another filter gets [`DEFAULT_FILTER_SIGMA`] and
+/// [`DEFAULT_FILTER_RADIUS`]; parameters under another filter are kept for nothing).
+#[must_use]
+pub fn filter_over(
+    name: Option<FilterName>,
+    sigma: Option<f32>,
+    radius: Option<f32>,
+    base: Filter,
+) -> Filter {
+    let (base_sigma, base_radius) = match base {
+        Filter::Gaussian { sigma, radius } => (sigma, radius),
+        _ => (DEFAULT_FILTER_SIGMA, DEFAULT_FILTER_RADIUS),
+    };
+    match name.unwrap_or(FilterName::from(base)) {
+        FilterName::Box => Filter::Box,
+        FilterName::Tent => Filter::Tent,
+        FilterName::Gaussian => Filter::Gaussian {
+            sigma: sigma.unwrap_or(base_sigma),
+            radius: radius.unwrap_or(base_radius),
+        },
     }
 }
 
@@ -828,7 +857,12 @@ pub fn settings(entry: &SettingsEntry, base: Settings) -> Settings {
         max_depth: entry.max_depth.unwrap_or(base.max_depth),
         integrator: integrator_over(entry.integrator, entry.max_path_length, base.integrator),
         sampler: entry.sampler.map_or(base.sampler, Into::into),
-        filter: entry.filter.map_or(base.filter, Into::into),
+        filter: filter_over(
+            entry.filter,
+            entry.filter_sigma,
+            entry.filter_radius,
+            base.filter,
+        ),
         seed: entry.seed.unwrap_or(base.seed),
     }
 }
@@ -1014,6 +1048,14 @@ pub fn to_scene_file(d: &SceneData<'_>, material_names: &[String]) -> SceneFile 
             },
             sampler: Some(s.sampler.into()),
             filter: Some(s.filter.into()),
+            filter_sigma: match s.filter {
+                Filter::Gaussian { sigma, .. } => Some(sigma),
+                _ => None,
+            },
+            filter_radius: match s.filter {
+                Filter::Gaussian { radius, .. } => Some(radius),
+                _ => None,
+            },
             seed: Some(s.seed),
         },
         materials,

@@ -9,9 +9,10 @@
 //! [`compute`], then rewrite the table with `BLESS=1 cargo test -p raykernel --test golden`.
 pub use crate::Rng;
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
-use raykernel::render::scenes::{self, SceneData};
+use raykernel::render::scenes::{self, ObjectData, SceneData, ShapeRange, SphereData};
 use raykernel::render::{
-    Integrator, Object, ObjectSlot, Problem, RenderMemory, Renderer, Settings, Shape, Tile,
+    Camera, Filter, Integrator, Material, Object, ObjectSlot, Problem, RenderMemory, Renderer,
+    SamplerKind, Settings, Shape, Tile,
 };
 use raykernel::spawn::SpawnScalar;
 use raykernel::{
@@ -30,7 +31,7 @@ const CENTER: [f32; 3] = [0.375, -0.25, 0.625];
 const RADIUS: f32 = 2.0;
 
 /// Every golden case, in file order.
-pub const NAMES: [&str; 20] = [
+pub const NAMES: [&str; 24] = [
     "rays_f32",
     "rays_fixed",
     "linear_f32",
@@ -51,6 +52,10 @@ pub const NAMES: [&str; 20] = [
     "render_motion_fixed",
     "render_cornell_path_f32",
     "render_cornell_path_fixed",
+    "render_emitters_f32",
+    "render_emitters_fixed",
+    "render_emitters_path_f32",
+    "render_emitters_path_fixed",
 ];
 
 /// What went wrong while computing a case.
@@ -348,6 +353,132 @@ pub const CORNELL_PATH: SceneData<'static> = SceneData {
     ..scenes::CORNELL
 };
 
+/// Lit by emissive geometry alone: a one-sided emissive quad mesh in the ceiling and a small
+/// sphere that both reflects and emits, over a floor, before a one-sided back wall, with a
+/// one-sided panel turned away from the camera (black, yet casting its shadow) and a diffuse
+/// sphere. Direct integrator.
+pub const EMITTERS: SceneData<'static> = SceneData {
+    name: "emitters",
+    triangles: &EMITTERS_TRIANGLES,
+    vertex_normals: &[],
+    spheres: &[
+        SphereData {
+            center: [-0.4, 0.3, 0.1],
+            radius: 0.3,
+        },
+        SphereData {
+            center: [0.5, 1.2, -0.5],
+            radius: 0.12,
+        },
+    ],
+    objects: &[
+        emitters_object(
+            ShapeRange::Triangles { first: 0, count: 2 },
+            0,
+            false,
+            [0.0; 3],
+        ),
+        emitters_object(
+            ShapeRange::Triangles { first: 2, count: 2 },
+            1,
+            true,
+            [0.0; 3],
+        ),
+        emitters_object(
+            ShapeRange::Triangles { first: 4, count: 2 },
+            0,
+            true,
+            [0.0; 3],
+        ),
+        emitters_object(
+            ShapeRange::Triangles { first: 6, count: 2 },
+            2,
+            true,
+            [0.0; 3],
+        ),
+        emitters_object(
+            ShapeRange::Spheres { first: 0, count: 1 },
+            1,
+            false,
+            [0.0; 3],
+        ),
+        emitters_object(
+            ShapeRange::Spheres { first: 1, count: 1 },
+            0,
+            false,
+            [2.0, 0.8, 0.3],
+        ),
+    ],
+    materials: &[
+        Material::Diffuse {
+            albedo: [0.7, 0.7, 0.7],
+        },
+        Material::Diffuse {
+            albedo: [0.3, 0.5, 0.8],
+        },
+        Material::Emissive {
+            radiance: [4.0, 4.0, 3.5],
+        },
+    ],
+    lights: &[],
+    camera: Camera {
+        eye: [0.0, 1.0, 3.0],
+        look_at: [0.0, 0.7, 0.0],
+        up: [0.0, 1.0, 0.0],
+        vfov_deg: 45.0,
+        aperture_radius: 0.0,
+        focus_distance: 1.0,
+    },
+    background: [0.0; 3],
+    settings: Settings {
+        width: 24,
+        height: 24,
+        spp: 4,
+        max_depth: 2,
+        integrator: Integrator::Direct,
+        sampler: SamplerKind::Stratified,
+        filter: Filter::Box,
+        seed: 5,
+    },
+};
+
+/// [`EMITTERS`] under the path integrator (four segments).
+pub const EMITTERS_PATH: SceneData<'static> = SceneData {
+    settings: Settings {
+        integrator: Integrator::Path { max_length: 4 },
+        ..EMITTERS.settings
+    },
+    ..EMITTERS
+};
+
+/// Floor (front up), back wall (front to the camera), a panel turned away from the camera,
+/// and the ceiling light (front down), each two triangles.
+const EMITTERS_TRIANGLES: [[[f32; 3]; 3]; 8] = [
+    [[-1.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 0.0, -1.0]],
+    [[-1.0, 0.0, 1.0], [1.0, 0.0, -1.0], [-1.0, 0.0, -1.0]],
+    [[-1.0, 0.0, -1.0], [1.0, 0.0, -1.0], [1.0, 2.0, -1.0]],
+    [[-1.0, 0.0, -1.0], [1.0, 2.0, -1.0], [-1.0, 2.0, -1.0]],
+    [[0.8, 0.0, 0.2], [0.2, 0.0, 0.2], [0.2, 0.6, 0.2]],
+    [[0.8, 0.0, 0.2], [0.2, 0.6, 0.2], [0.8, 0.6, 0.2]],
+    [[-0.4, 1.9, -0.4], [0.4, 1.9, -0.4], [0.4, 1.9, 0.4]],
+    [[-0.4, 1.9, -0.4], [0.4, 1.9, 0.4], [-0.4, 1.9, 0.4]],
+];
+
+const fn emitters_object(
+    shape: ShapeRange,
+    material: u32,
+    one_sided: bool,
+    emission: [f32; 3],
+) -> ObjectData {
+    ObjectData {
+        shape,
+        material,
+        motion: [0.0; 3],
+        emission,
+        one_sided,
+    }
+}
+
 const RENDER_SPHERES: usize = 4;
 const RENDER_OBJECTS: usize = 8;
 /// Widest built-in render (pixels), for the one-row buffer.
@@ -425,6 +556,10 @@ pub fn compute_render(name: &str) -> Result<u64, Fail> {
         "render_motion_fixed" => render_hash::<I16F16>(&scenes::MOTION),
         "render_cornell_path_f32" => render_hash::<f32>(&CORNELL_PATH),
         "render_cornell_path_fixed" => render_hash::<I16F16>(&CORNELL_PATH),
+        "render_emitters_f32" => render_hash::<f32>(&EMITTERS),
+        "render_emitters_fixed" => render_hash::<I16F16>(&EMITTERS),
+        "render_emitters_path_f32" => render_hash::<f32>(&EMITTERS_PATH),
+        "render_emitters_path_fixed" => render_hash::<I16F16>(&EMITTERS_PATH),
         _ => Err(Fail::UnknownCase),
     }
 }

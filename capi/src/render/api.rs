@@ -27,6 +27,8 @@ pub extern "C" fn rk_render_settings_default() -> RkRenderSettings {
         filter: match s.filter {
             Filter::Box => RK_FILTER_BOX,
             Filter::Tent => RK_FILTER_TENT,
+            // Not a default, and not offered by the C interface.
+            Filter::Gaussian { .. } => RK_FILTER_BOX,
         },
         seed: s.seed,
     }

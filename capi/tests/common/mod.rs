@@ -261,6 +261,7 @@ impl CScene {
         settings.filter = match s.filter {
             Filter::Box => RK_FILTER_BOX,
             Filter::Tent => RK_FILTER_TENT,
+            Filter::Gaussian { .. } => panic!("the C interface has no Gaussian filter"),
         };
         settings.seed = s.seed;
         let mut out = Self {

@@ -126,10 +126,10 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
                 base,
                 material: o.material,
                 emission: o.emission,
-                vertex_normals: o.vertex_normals,
                 one_sided: o.one_sided,
                 emitted,
                 emitter_base,
+                vertex_normals: o.vertex_normals,
                 motion,
                 swept,
             };
@@ -385,52 +385,6 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     }
 }
 
-/// The unit shading normal at barycentrics `(u, w)` (weights of the second and third corner):
-/// the corners' unit normals blended and normalised, turned to the side of the unit geometric
-/// normal `geometric`. `None` when the corners' normals are zero or blend to zero.
-fn interpolated_normal(
-    corners: &[[f32; 3]; 3],
-    u: f64,
-    w: f64,
-    geometric: &[f64; 3],
-) -> Option<[f64; 3]> {
-    let weights = [1.0 - u - w, u, w];
-    let mut blend = [0.0f64; 3];
-    for (corner, weight) in corners.iter().zip(weights) {
-        if let Some(c) = unit(corner.map(f64::from)) {
-            for (b, x) in blend.iter_mut().zip(c) {
-                *b += weight * x;
-            }
-        }
-    }
-    let s = unit(blend)?;
-    let toward = s[0] * geometric[0] + s[1] * geometric[1] + s[2] * geometric[2];
-    Some(if toward < 0.0 { s.map(|x| -x) } else { s })
-}
-
-/// Vertex normals: none, or one finite triple per triangle of a triangle shape.
-fn check_vertex_normals<S: Scalar>(o: &Object<'_, S>) -> Result<(), Problem> {
-    if o.vertex_normals.is_empty() {
-        return Ok(());
-    }
-    let expected = match o.shape {
-        Shape::Triangles(t) => t.len(),
-        Shape::Spheres(_) => 0,
-    };
-    if o.vertex_normals.len() != expected {
-        return Err(Problem::Length { expected });
-    }
-    if o.vertex_normals
-        .iter()
-        .flatten()
-        .all(|n| super::scene::finite3(*n))
-    {
-        Ok(())
-    } else {
-        Err(Problem::NonFinite)
-    }
-}
-
 impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     /// The unit geometric normal [`Geometry::surface_point`] gives for hit `h`, without the
     /// rest of the surface point (no barycentrics). `None` for lights.
@@ -490,6 +444,52 @@ pub(super) fn emitted_by<S: Scalar>(
             s
         }
     })
+}
+
+/// The unit shading normal at barycentrics `(u, w)` (weights of the second and third corner):
+/// the corners' unit normals blended and normalised, turned to the side of the unit geometric
+/// normal `geometric`. `None` when the corners' normals are zero or blend to zero.
+fn interpolated_normal(
+    corners: &[[f32; 3]; 3],
+    u: f64,
+    w: f64,
+    geometric: &[f64; 3],
+) -> Option<[f64; 3]> {
+    let weights = [1.0 - u - w, u, w];
+    let mut blend = [0.0f64; 3];
+    for (corner, weight) in corners.iter().zip(weights) {
+        if let Some(c) = unit(corner.map(f64::from)) {
+            for (b, x) in blend.iter_mut().zip(c) {
+                *b += weight * x;
+            }
+        }
+    }
+    let s = unit(blend)?;
+    let toward = s[0] * geometric[0] + s[1] * geometric[1] + s[2] * geometric[2];
+    Some(if toward < 0.0 { s.map(|x| -x) } else { s })
+}
+
+/// Vertex normals: none, or one finite triple per triangle of a triangle shape.
+fn check_vertex_normals<S: Scalar>(o: &Object<'_, S>) -> Result<(), Problem> {
+    if o.vertex_normals.is_empty() {
+        return Ok(());
+    }
+    let expected = match o.shape {
+        Shape::Triangles(t) => t.len(),
+        Shape::Spheres(_) => 0,
+    };
+    if o.vertex_normals.len() != expected {
+        return Err(Problem::Length { expected });
+    }
+    if o.vertex_normals
+        .iter()
+        .flatten()
+        .all(|n| super::scene::finite3(*n))
+    {
+        Ok(())
+    } else {
+        Err(Problem::NonFinite)
+    }
 }
 
 fn union_bounds<S: Scalar, P: Primitive<S>>(prims: &[P]) -> Option<Aabb<S>> {

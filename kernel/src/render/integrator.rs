@@ -5,7 +5,7 @@
 
 use super::geometry::{SceneHit, Surface};
 use super::lighting::{light_sum, Lobe};
-use super::sampling::{phong_lobe, tent, to_world, SampleStream};
+use super::sampling::{gaussian, phong_lobe, tent, to_world, SampleStream};
 use super::scene::{Filter, Light, Material};
 use super::surface::dir_in_mode;
 use super::{RenderPlan, RenderStats, Renderer};
@@ -144,6 +144,10 @@ pub(crate) fn camera_sample<S: SpawnScalar, F: AccelFamily<S>>(
         match plan.filter {
             Filter::Box => (a, b),
             Filter::Tent => (0.5 + tent(a), 0.5 + tent(b)),
+            Filter::Gaussian { sigma, radius } => (
+                0.5 + gaussian(a, sigma, radius),
+                0.5 + gaussian(b, sigma, radius),
+            ),
         }
     };
     let lens = plan.lens.then(|| stream.next_2d());

@@ -171,16 +171,40 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
         }
     }
     if r.plan.emissive_geometry {
-        if let Some(s) = emitters::sample(r, pf, nf, lobe, mis, time, stream) {
-            if s.contribution != Vec3::ZERO && facing.leaves(Vec3::from_array(s.target) - pf) {
-                stats.shadow_rays += 1;
-                if visible(r, sp, s.target, time, true) {
-                    sum += s.contribution;
-                }
-            }
-        }
+        sum += emitter_light(r, sp, facing, lobe, mis, time, stream, stats);
     }
     sum
+}
+
+/// The emissive geometry's share of [`light_sum`]: one sample ([`emitters::sample`]) and its
+/// shadow ray. Kept out of line: scenes without emissive geometry carry only the branch to it
+/// in their shading loop.
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+fn emitter_light<S: SpawnScalar, F: AccelFamily<S>>(
+    r: &Renderer<'_, S, F>,
+    sp: &SurfacePoint<'_, S>,
+    facing: Facing,
+    lobe: Lobe,
+    mis: bool,
+    time: f32,
+    stream: &mut SampleStream,
+    stats: &mut RenderStats,
+) -> Vec3 {
+    let p = sp.position;
+    let pf = Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
+    let Some(s) = emitters::sample(r, pf, facing.shading, lobe, mis, time, stream) else {
+        return Vec3::ZERO;
+    };
+    if s.contribution == Vec3::ZERO || !facing.leaves(Vec3::from_array(s.target) - pf) {
+        return Vec3::ZERO;
+    }
+    stats.shadow_rays += 1;
+    if visible(r, sp, s.target, time, true) {
+        s.contribution
+    } else {
+        Vec3::ZERO
+    }
 }
 
 /// The solid-angle density with which [`light_sum`] samples the unit direction `dir` from

@@ -55,7 +55,7 @@ use sampling::Sampler;
 
 /// What a render will do, derived once from the scene and settings. Features marked `false`
 /// are skipped entirely (no samples drawn, no rays cast).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderPlan {
     /// Samples per pixel.
     pub spp: u32,
@@ -500,6 +500,22 @@ fn check_settings(s: &Settings) -> Result<(), SceneError> {
             max: u32::MAX as f32,
         };
         return err("height", p);
+    }
+    if let Filter::Gaussian { sigma, radius } = s.filter {
+        for (field, v, max) in [
+            ("filter_sigma", sigma, f32::MAX),
+            ("filter_radius", radius, Filter::MAX_RADIUS),
+        ] {
+            if !v.is_finite() {
+                return err(field, Problem::NonFinite);
+            }
+            if v <= 0.0 {
+                return err(field, Problem::NotPositive);
+            }
+            if v > max {
+                return err(field, Problem::OutOfRange { min: 0.0, max });
+            }
+        }
     }
     if let Integrator::Path { max_length } = s.integrator {
         if !cfg!(feature = "path-tracing") {

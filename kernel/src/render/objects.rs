@@ -118,8 +118,6 @@ pub(crate) struct ObjectGeom<'a, S: Scalar, F: AccelFamily<S>> {
     pub(crate) material: u32,
     /// Emitted radiance (checked).
     pub(crate) emission: super::scene::Rgb,
-    /// Per-triangle vertex normals, empty or one entry per triangle (checked).
-    pub(super) vertex_normals: &'a [[[f32; 3]; 3]],
     /// Reflects and emits on the front only ([`super::Object::one_sided`]).
     pub(crate) one_sided: bool,
     /// Radiance its surfaces emit: [`super::Object::emission`] plus an emissive material's
@@ -128,6 +126,8 @@ pub(crate) struct ObjectGeom<'a, S: Scalar, F: AccelFamily<S>> {
     /// Emissive primitives of the objects before this one: for an emitter, the index of its
     /// first primitive among the scene's emissive primitives ([`super::emitters`]).
     pub(crate) emitter_base: u32,
+    /// Per-triangle vertex normals, empty or one entry per triangle (checked).
+    pub(super) vertex_normals: &'a [[[f32; 3]; 3]],
     /// Motion over the shutter, `None` when static.
     pub(super) motion: Option<[f32; 3]>,
     /// World box over the whole shutter interval (for a static object, its primitives' box).

@@ -265,6 +265,75 @@ pub fn tent(u: f32) -> f32 {
     }
 }
 
+/// A Gaussian-distributed offset of standard deviation `sigma`, truncated to `(-radius,
+/// radius)`, from a uniform `u` in `[0, 1)`: the inverse CDF of the truncated normal,
+/// `σ·√2·erf⁻¹(e·(2u − 1))` with `e = erf(radius / (σ·√2))`, with `libm`'s `f32` functions
+/// (the same bits everywhere, and no `f64` library code on cores without a double FPU);
+/// `erf⁻¹` is Giles' single-precision polynomial refined by two Newton steps. Callers check
+/// `sigma > 0` and `radius > 0`, both finite.
+#[must_use]
+pub fn gaussian(u: f32, sigma: f32, radius: f32) -> f32 {
+    let s = sigma * core::f32::consts::SQRT_2;
+    let e = libm::erff(radius / s);
+    let x = s * erf_inv(e * (2.0 * u - 1.0));
+    // Rounding may reach the bound; keep the offset inside it.
+    let r = radius * (1.0 - f32::EPSILON);
+    if x > r {
+        r
+    } else if x < -r {
+        -r
+    } else {
+        x
+    }
+}
+
+/// `erf⁻¹(y)` for `|y| < 1` (M. Giles, "Approximating the erfinv function", 2010, single
+/// precision, then two Newton steps on `erf`).
+fn erf_inv(y: f32) -> f32 {
+    // `erf` rounds to ±1 far from 0: keep the logarithm finite (the caller clamps the result).
+    const LIMIT: f32 = 1.0 - f32::EPSILON / 2.0;
+    let y = y.clamp(-LIMIT, LIMIT);
+    let w = -libm::logf((1.0 - y) * (1.0 + y));
+    let mut x = if w < 5.0 {
+        let w = w - 2.5;
+        let c = [
+            2.810_226_4e-8,
+            3.432_739_4e-7,
+            -3.523_387_7e-6,
+            -4.391_506_5e-6,
+            2.185_808_7e-4,
+            -1.253_725_1e-3,
+            -4.177_681_6e-3,
+            2.466_407_2e-1,
+            1.501_409_4,
+        ];
+        c.iter().fold(0.0, |p, &k| k + p * w) * y
+    } else {
+        let w = libm::sqrtf(w) - 3.0;
+        let c = [
+            -2.002_142_6e-4,
+            1.009_505_6e-4,
+            1.349_343_2e-3,
+            -3.673_428_4e-3,
+            5.739_507_7e-3,
+            -7.622_461_3e-3,
+            9.438_870_5e-3,
+            1.001_674,
+            2.832_976_8,
+        ];
+        c.iter().fold(0.0, |p, &k| k + p * w) * y
+    };
+    // d/dx erf(x) = 2/√π · e^(−x²).
+    let two_over_sqrt_pi = core::f32::consts::FRAC_2_SQRT_PI;
+    for _ in 0..2 {
+        let slope = two_over_sqrt_pi * libm::expf(-x * x);
+        if slope > 0.0 {
+            x -= (libm::erff(x) - y) / slope;
+        }
+    }
+    x
+}
+
 /// A point on the unit disk, area-uniform (Shirley–Chiu concentric map).
 #[must_use]
 pub fn concentric_disk(u: f32, v: f32) -> (f32, f32) {

@@ -96,17 +96,17 @@ pub struct Object<'a, S: Scalar> {
     /// material reflects; from both sides unless [`Object::one_sided`]. An area light, as an
     /// emissive material is ([`Material::Emissive`]). Zero for most objects.
     pub emission: Rgb,
-    /// Smooth shading: for each triangle of a [`Shape::Triangles`] shape, the normals at its
-    /// three vertices (any length; interpolated by the hit's barycentrics and normalised), or
-    /// empty for flat shading. A triangle whose normals are all zero is shaded flat. The
-    /// geometric normal still decides offsets, sidedness and which directions leave the surface.
-    pub vertex_normals: &'a [[[f32; 3]; 3]],
     /// One-sided: the object reflects and emits only on the front of its surfaces, the side
     /// the geometric normal points to (a triangle's `(v1 − v0) × (v2 − v0)`: its vertices run
     /// counter-clockwise seen from the front; a sphere's outside). Seen from behind it is
     /// black, and it blocks light from both sides. `false` (two-sided, the default): both
     /// sides reflect and emit alike.
     pub one_sided: bool,
+    /// Smooth shading: for each triangle of a [`Shape::Triangles`] shape, the normals at its
+    /// three vertices (any length; interpolated by the hit's barycentrics and normalised), or
+    /// empty for flat shading. A triangle whose normals are all zero is shaded flat. The
+    /// geometric normal still decides offsets, sidedness and which directions leave the surface.
+    pub vertex_normals: &'a [[[f32; 3]; 3]],
 }
 
 impl<'a, S: Scalar> Object<'a, S> {
@@ -118,8 +118,8 @@ impl<'a, S: Scalar> Object<'a, S> {
             material,
             motion: [0.0; 3],
             emission: [0.0; 3],
-            vertex_normals: &[],
             one_sided: false,
+            vertex_normals: &[],
         }
     }
     /// True if the object moves during the shutter interval.
@@ -190,22 +190,35 @@ pub struct Camera {
 }
 
 /// Pixel reconstruction filter, applied by importance sampling (every sample has weight 1).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum Filter {
     /// Uniform over the pixel.
     #[default]
     Box,
     /// Triangle filter of radius one pixel.
     Tent,
+    /// Gaussian of standard deviation `sigma` pixels about the pixel centre, per axis,
+    /// truncated at `radius` pixels (a square support: the product of two truncated 1D
+    /// Gaussians).
+    Gaussian {
+        /// Standard deviation, pixels (finite, `> 0`).
+        sigma: f32,
+        /// Truncation radius, pixels (finite, `> 0`, at most [`Filter::MAX_RADIUS`]).
+        radius: f32,
+    },
 }
 
 impl Filter {
+    /// Largest Gaussian truncation radius, pixels.
+    pub const MAX_RADIUS: f32 = 16.0;
+
     /// Lower-case name as used on command lines.
     #[must_use]
     pub const fn name(self) -> &'static str {
         match self {
             Self::Box => "box",
             Self::Tent => "tent",
+            Self::Gaussian { .. } => "gaussian",
         }
     }
 }

@@ -214,8 +214,8 @@ impl<'d> SceneData<'d> {
                 material: o.material,
                 motion: o.motion,
                 emission: o.emission,
-                vertex_normals,
                 one_sided: o.one_sided,
+                vertex_normals,
             };
         }
         let n = self.objects.len();

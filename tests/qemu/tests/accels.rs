@@ -30,6 +30,7 @@ fn fail_name(f: Fail) -> &'static str {
         Fail::Build => "build failed",
         Fail::Invalid => "validate() rejected the structure",
         Fail::Differs { .. } => "differs from brute force",
+        Fail::NotLinked => "needs a kernel feature this build leaves out (path-tracing)",
     }
 }
 

@@ -43,6 +43,14 @@ mod tests {
     fn golden_render_cornell_path_f32() {
         check_render_golden::<f32>("render_cornell_path_f32", &cases::CORNELL_PATH)
     }
+    #[test]
+    fn golden_render_emitters_f32() {
+        check_render_golden::<f32>("render_emitters_f32", &cases::EMITTERS)
+    }
+    #[test]
+    fn golden_render_emitters_path_f32() {
+        check_render_golden::<f32>("render_emitters_path_f32", &cases::EMITTERS_PATH)
+    }
     /// Stack used by a whole render (scene conversion, per-object BVH builds, renderer, one
     /// row of pixels) of the default scene, printed for the footprint table.
     #[test]

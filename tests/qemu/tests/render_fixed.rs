@@ -44,6 +44,14 @@ mod tests {
     fn golden_render_cornell_path_fixed() {
         check_render_golden::<I16F16>("render_cornell_path_fixed", &cases::CORNELL_PATH)
     }
+    #[test]
+    fn golden_render_emitters_fixed() {
+        check_render_golden::<I16F16>("render_emitters_fixed", &cases::EMITTERS)
+    }
+    #[test]
+    fn golden_render_emitters_path_fixed() {
+        check_render_golden::<I16F16>("render_emitters_path_fixed", &cases::EMITTERS_PATH)
+    }
     /// Stack used by a whole render (scene conversion, per-object BVH builds, renderer, one
     /// row of pixels) of the default scene, printed for the footprint table.
     #[test]
