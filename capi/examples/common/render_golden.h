@@ -9,9 +9,9 @@
 #define RK_TEST_TILE_Y 4u
 #define RK_TEST_TILE_W 8u
 #define RK_TEST_TILE_H 8u
-#define RK_TEST_IMAGE_HASH_F32 0x97a94dfbu
-#define RK_TEST_IMAGE_HASH_FIXED 0x0914065bu
-#define RK_TEST_TILE_HASH_F32 0xedb99da8u
-#define RK_TEST_TILE_HASH_FIXED 0xd1809b10u
+#define RK_TEST_IMAGE_HASH_F32 0xcbcbae7cu
+#define RK_TEST_IMAGE_HASH_FIXED 0x46c80fcdu
+#define RK_TEST_TILE_HASH_F32 0x2389d5b8u
+#define RK_TEST_TILE_HASH_FIXED 0x23e57cedu
 
 #endif
