@@ -3,12 +3,13 @@
 //! geometric normal still decides which directions leave the surface, and bad normal lists are
 //! typed errors.
 
+mod common;
+
 use raykernel::render::{
-    memory_needed, Camera, Item, Light, Material, Object, ObjectSlot, Problem, RenderMemory,
-    Renderer, Scene, SceneError, Settings, Shape, Tile,
+    Camera, Item, Light, Material, Object, Problem, Scene, SceneError, Settings, Shape,
 };
 use raykernel::spawn::SpawnScalar;
-use raykernel::{AccelMemory, BvhFamily, Node, Triangle, I16F16};
+use raykernel::{Triangle, I16F16};
 
 /// The floor: one triangle in `y = 0` whose corners are chosen so the origin has barycentrics
 /// `(u, v) = (1/4, 1/4)`; its winding makes the geometric normal point down (`-y`).
@@ -55,29 +56,7 @@ fn pixel<S: SpawnScalar>(
         spp: 1,
         ..Settings::default()
     };
-    let accel = Default::default();
-    let need = memory_needed::<S, BvhFamily>(&objects, &accel);
-    let mut slots = vec![ObjectSlot::EMPTY; need.objects];
-    let mut nodes = vec![Node::EMPTY; need.accel.nodes];
-    let mut words = vec![0u32; need.accel.words];
-    let memory = RenderMemory {
-        objects: &mut slots,
-        accel: AccelMemory {
-            nodes: &mut nodes,
-            words: &mut words,
-            ..AccelMemory::default()
-        },
-    };
-    let r = Renderer::<S, BvhFamily>::new(&scene, settings, accel, memory)?;
-    let mut out = [[0.0f32; 3]; 1];
-    let tile = Tile {
-        x: 0,
-        y: 0,
-        width: 1,
-        height: 1,
-    };
-    r.render_tile(tile, &mut out)?;
-    Ok(out[0])
+    Ok(common::render_linear(&scene, settings)?[0])
 }
 
 /// The radiance of the floor at the origin under the light at `(0, 2, 0)` for a shading normal
