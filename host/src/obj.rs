@@ -341,15 +341,7 @@ pub fn parse_obj_with_materials(
             .filter(|t| !t.is_empty());
         match tokens.next() {
             Some(b"v") => {
-                let mut xyz = [0.0f32; 3];
-                let mut count = 0usize;
-                for token in tokens {
-                    let x = parse_f32(token).map_err(|kind| err(line_no, kind))?;
-                    if let Some(slot) = xyz.get_mut(count) {
-                        *slot = x;
-                    }
-                    count += 1;
-                }
+                let (xyz, count) = parse_numbers(tokens).map_err(|kind| err(line_no, kind))?;
                 if !matches!(count, 3 | 4 | 6) {
                     return Err(err(line_no, ObjErrorKind::VertexArity { count }));
                 }
@@ -357,15 +349,7 @@ pub fn parse_obj_with_materials(
                 mesh.position_lines.push(line_no);
             }
             Some(b"vn") => {
-                let mut xyz = [0.0f32; 3];
-                let mut count = 0usize;
-                for token in tokens {
-                    let x = parse_f32(token).map_err(|kind| err(line_no, kind))?;
-                    if let Some(slot) = xyz.get_mut(count) {
-                        *slot = x;
-                    }
-                    count += 1;
-                }
+                let (xyz, count) = parse_numbers(tokens).map_err(|kind| err(line_no, kind))?;
                 if count != 3 {
                     return Err(err(line_no, ObjErrorKind::NormalArity { count }));
                 }
@@ -457,6 +441,22 @@ fn show(token: &[u8]) -> String {
         out.push('…');
     }
     out
+}
+
+/// A statement's numbers: the first three, and how many there were.
+fn parse_numbers<'t>(
+    tokens: impl Iterator<Item = &'t [u8]>,
+) -> Result<([f32; 3], usize), ObjErrorKind> {
+    let mut xyz = [0.0f32; 3];
+    let mut count = 0usize;
+    for token in tokens {
+        let x = parse_f32(token)?;
+        if let Some(slot) = xyz.get_mut(count) {
+            *slot = x;
+        }
+        count += 1;
+    }
+    Ok((xyz, count))
 }
 
 fn parse_f32(token: &[u8]) -> Result<f32, ObjErrorKind> {
