@@ -400,11 +400,7 @@ impl Transform {
     /// The transformed point, computed in `f64` and rounded to `f32` once.
     #[must_use]
     pub fn apply(&self, p: [f32; 3]) -> [f32; 3] {
-        let s = match self.scale {
-            None => [1.0; 3],
-            Some(Scale::Uniform(s)) => [s; 3],
-            Some(Scale::PerAxis(s)) => s,
-        };
+        let s = self.scale_factors();
         let mut q: [f64; 3] = std::array::from_fn(|k| f64::from(p[k]) * s[k]);
         self.rotate(&mut q);
         let t = self.translate.unwrap_or([0.0; 3]);
@@ -416,17 +412,22 @@ impl Transform {
     /// zero. Its length is not kept (the kernel normalises).
     #[must_use]
     pub fn apply_normal(&self, n: [f32; 3]) -> [f32; 3] {
-        let s = match self.scale {
-            None => [1.0; 3],
-            Some(Scale::Uniform(s)) => [s; 3],
-            Some(Scale::PerAxis(s)) => s,
-        };
+        let s = self.scale_factors();
         if s.contains(&0.0) {
             return [0.0; 3];
         }
         let mut q: [f64; 3] = std::array::from_fn(|k| f64::from(n[k]) / s[k]);
         self.rotate(&mut q);
         q.map(|x| x as f32)
+    }
+
+    /// The scale per axis (1 without one).
+    fn scale_factors(&self) -> [f64; 3] {
+        match self.scale {
+            None => [1.0; 3],
+            Some(Scale::Uniform(s)) => [s; 3],
+            Some(Scale::PerAxis(s)) => s,
+        }
     }
 
     /// Applies the rotations about x, then y, then z.
