@@ -8,6 +8,7 @@
 use crate::error::Error;
 use host::render::{render, RenderError, RenderOptions};
 use host::trace::Mode;
+use raykernel::glam::DVec3;
 use raykernel::render::scenes;
 use raykernel::render::{Integrator, SamplerKind, Settings};
 use serde::Serialize;
@@ -238,40 +239,24 @@ fn glossy_sphere_pixels(data: &scenes::SceneData<'_>, (w, h): (u32, u32)) -> Vec
         return Vec::new();
     };
     let c = data.camera;
-    let v = |a: [f32; 3]| a.map(f64::from);
-    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let cross = |a: [f64; 3], b: [f64; 3]| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let unit = |a: [f64; 3]| {
-        let l = dot(a, a).sqrt();
-        a.map(|x| x / l)
-    };
+    let v = |a: [f32; 3]| DVec3::from_array(a.map(f64::from));
     let eye = v(c.eye);
-    let forward = unit(sub(v(c.look_at), eye));
-    let right = unit(cross(forward, v(c.up)));
-    let up = cross(right, forward);
+    let forward = (v(c.look_at) - eye).normalize();
+    let right = forward.cross(v(c.up)).normalize();
+    let up = right.cross(forward);
     let half = (f64::from(c.vfov_deg).to_radians() / 2.0).tan();
     let aspect = f64::from(w) / f64::from(h);
-    let centre = v(sphere.center);
+    let to = v(sphere.center) - eye;
     let r = 0.9 * f64::from(sphere.radius);
     (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
         .filter(|&(x, y)| {
             let sx = (2.0 * (f64::from(x) + 0.5) / f64::from(w) - 1.0) * half * aspect;
             let sy = (1.0 - 2.0 * (f64::from(y) + 0.5) / f64::from(h)) * half;
-            let d = unit(std::array::from_fn(|k| {
-                forward[k] + sx * right[k] + sy * up[k]
-            }));
+            let d = (forward + sx * right + sy * up).normalize();
             // Distance from the centre to the ray's line, for a sphere in front of the eye.
-            let to = sub(centre, eye);
-            let along = dot(to, d);
-            along > 0.0 && dot(to, to) - along * along < r * r
+            let along = to.dot(d);
+            along > 0.0 && to.length_squared() - along * along < r * r
         })
         .map(|(x, y)| (y * w + x) as usize)
         .collect()
@@ -303,5 +288,13 @@ mod tests {
         // One channel of six differs by 2: sqrt(4 / 6).
         assert!((rmse(&a, &b) - (4.0f64 / 6.0).sqrt()).abs() < 1e-12);
         assert_eq!(rmse(&a, &a), 0.0);
+    }
+
+    #[test]
+    fn the_glossy_sphere_lies_right_of_centre_below_the_middle() {
+        let px = glossy_sphere_pixels(&scenes::CORNELL, (64, 64));
+        assert!(px.len() > 100, "{} pixels", px.len());
+        // Its centre (0.45, 0.35, 0.3) is right of and below the view's centre.
+        assert!(px.iter().all(|&i| i % 64 >= 32 && i / 64 >= 32));
     }
 }
