@@ -15,6 +15,7 @@
 //! - [`scale`]: the tiled scene from 10k to 1M+ triangles,
 //! - [`refit`]: refitting the trees after the mesh moved, against rebuilding them,
 //! - [`images`]: the renderer's image error against time, per sampler,
+//! - [`fireflies`]: isolated bright pixels around the glossy highlight, per integrator,
 //! - [`gi`]: the path tracer against Mitsuba 3 on a Cornell box, error against time,
 //! - [`overhead`]: the renderer against hand-written casters (the render plan's cost),
 //! - [`report`], [`figures`], [`plot`], [`stats`]: Markdown, CSV, JSON and PNG output,
@@ -30,6 +31,7 @@ pub mod cli;
 pub mod embree;
 pub mod error;
 pub mod figures;
+pub mod fireflies;
 pub mod gi;
 pub mod images;
 pub mod machine;
@@ -199,7 +201,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
         None => Vec::new(),
     };
     let firefly_rows = match &config.images {
-        Some(opts) => images::fireflies(config.quick, opts.threads)?,
+        Some(opts) => fireflies::run(config.quick, opts.threads)?,
         None => Vec::new(),
     };
     let gi_results = config.gi.as_ref().map(gi::run).transpose()?;

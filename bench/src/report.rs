@@ -3,8 +3,9 @@
 //! structured) and `plots/*.png`.
 
 use crate::error::Error;
+use crate::fireflies::{self, FireflyRow};
 use crate::gi::{time_to_reach, GiResults, GiRow};
-use crate::images::{FireflyRow, ImageRow};
+use crate::images::ImageRow;
 use crate::machine::Machine;
 use crate::objects::ObjectsRow;
 use crate::overhead::OverheadRow;
@@ -1086,22 +1087,45 @@ fn fireflies_section(s: &mut String, rows: &[FireflyRow]) {
     let _ = writeln!(
         s,
         "### Fireflies: per-pixel error of the default scene\n\n\
-         `cornell` at {}×{}, {} Sobol spp, against a {}-spp reference of the same integrator. \
-         The direct integrator reflects the small area light in the glossy sphere by sampling \
-         the lobe alone; the path integrator also samples the light at glossy vertices, \
-         weighted by MIS. Per-pixel error: RMS over the channels of the linear difference.\n",
-        first.size.0, first.size.1, first.spp, first.reference_spp
+         `cornell` at {}×{}, {} renders of {} Sobol spp (seeds 1-{}) against a {}-spp \
+         reference (seed 0) of the same integrator. The direct integrator reflects the small \
+         area light in the glossy sphere by sampling the lobe alone; the path integrator also \
+         samples the light at glossy vertices, weighted by MIS. Percentiles pool every pixel of \
+         the region over the renders. Linear error: RMS over the channels of the difference. \
+         Display error: the luminance's 8-bit sRGB value against the reference's, on [0, 1]. \
+         An isolated firefly is a pixel at least {}× as bright as its reference, {} or more \
+         brighter on display, and by more than {}× the median display error of its eight \
+         neighbours; the count sums the renders. The glossy highlight is the sphere's pixels \
+         within 5% of the width of one whose reference luminance exceeds 1.\n",
+        first.size.0,
+        first.size.1,
+        first.renders,
+        first.spp,
+        first.renders,
+        first.reference_spp,
+        fireflies::BRIGHTER,
+        fireflies::VISIBLE,
+        fireflies::ISOLATED,
     );
     let _ = writeln!(
         s,
-        "| integrator | pixels | median | 99th percentile | 99.9th percentile | largest |\n\
-         |---|---|---:|---:|---:|---:|"
+        "| integrator | pixels | count | linear median | 99th percentile | 99.9th percentile | \
+         largest | display 99.9th percentile | isolated fireflies |\n\
+         |---|---|---:|---:|---:|---:|---:|---:|---:|"
     );
     for x in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {:.5} | {:.5} | {:.5} | {:.5} |",
-            x.integrator, x.region, x.median, x.p99, x.p999, x.max
+            "| {} | {} | {} | {:.5} | {:.5} | {:.5} | {:.5} | {:.4} | {} |",
+            x.integrator,
+            x.region,
+            x.pixels,
+            x.median,
+            x.p99,
+            x.p999,
+            x.max,
+            x.display_p999,
+            x.fireflies
         );
     }
     s.push('\n');
