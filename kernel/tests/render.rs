@@ -601,8 +601,8 @@ fn plans_follow_the_scenes() {
 /// A plan of camera rays only takes the renderer's first-hit loop; a zero-intensity point light
 /// changes nothing in the picture of black diffuse surfaces against the background but makes
 /// the plan take the general path loop. Both must give the same bits, in both modes, for
-/// every built-in scene made static, pinhole and one sample per pixel. (Emissive geometry
-/// lights the scene, so it takes the general loop: see `tests/emitters.rs`.)
+/// every built-in scene made static, pinhole and one sample per pixel. (Emitters seen
+/// directly: `emitters_only_case`.)
 /// Returns how many values show the background.
 fn camera_rays_only_case<S: SpawnScalar>(d: &SceneData<'_>) -> usize {
     // Every material diffuse (black without lights), and a background that is not.
@@ -665,6 +665,105 @@ fn camera_rays_only_loop_equals_the_general_path() {
         background += camera_rays_only_case::<I16F16>(&d);
     }
     assert!(background > 0, "some picture shows the background");
+}
+
+/// A scene whose every object emits through an emissive material (some also through
+/// [`scenes::ObjectData::emission`], some one-sided) has nothing a light could reach, so its
+/// plan takes the first-hit loop whatever its lights; one diffuse sphere behind the camera,
+/// never seen, makes the plan take the general loop. Both must give the same bits.
+/// Returns how many values differ from zero and from the background.
+fn emitters_only_case<S: SpawnScalar>(d: &SceneData<'_>) -> usize {
+    let materials: Vec<Material> = (0..d.materials.len())
+        .map(|i| Material::Emissive {
+            radiance: [0.3 + 0.1 * i as f32, 0.5, 0.9 - 0.1 * i as f32],
+        })
+        .chain([Material::Diffuse { albedo: [0.5; 3] }])
+        .collect();
+    let mut objects: Vec<_> = d
+        .objects
+        .iter()
+        .enumerate()
+        .map(|(i, o)| scenes::ObjectData {
+            motion: [0.0; 3],
+            emission: if i % 3 == 0 {
+                [0.25, 0.0, 0.5]
+            } else {
+                [0.0; 3]
+            },
+            one_sided: i % 2 == 1,
+            ..*o
+        })
+        .collect();
+    let camera = Camera {
+        aperture_radius: 0.0,
+        ..d.camera
+    };
+    let behind: [f32; 3] = core::array::from_fn(|k| 2.0 * camera.eye[k] - camera.look_at[k]);
+    let mut spheres = d.spheres.to_vec();
+    spheres.push(scenes::SphereData {
+        center: behind,
+        radius: 0.01,
+    });
+    let hidden = scenes::ObjectData {
+        shape: scenes::ShapeRange::Spheres {
+            first: d.spheres.len() as u32,
+            count: 1,
+        },
+        material: d.materials.len() as u32,
+        motion: [0.0; 3],
+        emission: [0.0; 3],
+        one_sided: false,
+    };
+    let settings = Settings {
+        spp: 1,
+        ..d.settings
+    };
+    let background = [0.2, 0.7, 0.4];
+    let mut images = Vec::new();
+    for (extra, first_hit) in [(0, true), (1, false)] {
+        if extra == 1 {
+            objects.push(hidden);
+        }
+        let data = SceneData {
+            objects: &objects,
+            materials: &materials,
+            spheres: &spheres,
+            camera,
+            settings,
+            background,
+            ..*d
+        };
+        with_scene::<S, _>(&data, |scene| {
+            let mut memory = Memory::new(scene, AccelKind::default());
+            let r = Renderer::new(scene, settings, AccelKind::default(), memory.lend()).unwrap();
+            assert_eq!(r.plan().camera_rays_only(), first_hit, "{}", d.name);
+            let image = render(scene, settings, AccelKind::default()).unwrap();
+            images.push(image);
+        });
+    }
+    let bits =
+        |im: &Vec<[f32; 3]>| -> Vec<u32> { im.iter().flatten().map(|x| x.to_bits()).collect() };
+    assert_eq!(bits(&images[0]), bits(&images[1]), "{} {}", d.name, S::NAME);
+    images[0]
+        .iter()
+        .filter(|&&p| p != [0.0; 3] && p != background)
+        .count()
+}
+
+#[test]
+fn an_emitters_only_scene_takes_the_first_hit_loop_with_the_same_bits() {
+    for d in scenes::ALL {
+        assert!(
+            emitters_only_case::<f32>(&d) > 0,
+            "{}: no emitter seen",
+            d.name
+        );
+        assert!(
+            emitters_only_case::<I16F16>(&d) > 0,
+            "{}: no emitter seen",
+            d.name
+        );
+    }
 }
 
 /// A valid one-object scene to corrupt field by field.

@@ -159,10 +159,10 @@ pub(crate) fn camera_sample<S: SpawnScalar, F: AccelFamily<S>>(
 
 /// Radiance of pixel `(x, y)` when the plan needs only what camera rays see
 /// ([`RenderPlan::camera_rays_only`]): one ray through the pixel centre from the renderer's
-/// eye ray, a static scene, no lights to sample, no emissive geometry and nothing reflecting.
-/// Light surfaces seen directly and the background are then the whole picture; objects are
-/// black. The same bits as [`sample_radiance`] under that plan (the same
-/// operations in the same order), without its sample stream, path state and bounce loop.
+/// eye ray, a static scene, and nothing a light could reach. The background, light surfaces
+/// and emitters seen directly are then the whole picture; other objects are black. The same
+/// bits as [`sample_radiance`] under that plan (the same operations in the same order),
+/// without its sample stream, path state and bounce loop.
 #[cfg_attr(not(target_os = "none"), inline(always))]
 pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>>(
     r: &Renderer<'_, S, F>,
@@ -182,9 +182,23 @@ pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>>(
         None => Vec3::from_array(r.background),
         Some(hit) => match hit.surface {
             Surface::Light { light } => light_seen(r, light, d.normalize_or_zero()),
-            // Nothing emits under this plan (emissive geometry lights the scene, so it takes
-            // the general loop) and nothing is lit.
-            Surface::Object { .. } => return Vec3::ZERO,
+            // Emitters add what they emit, as the general loop adds it; nothing is lit.
+            Surface::Object { object, .. } => {
+                let plan = &r.plan;
+                if plan.one_sided
+                    && behind_one_sided(r, ray, &hit, 0.0, object, d.normalize_or_zero())
+                {
+                    return Vec3::ZERO;
+                }
+                let mut radiance = Vec3::ZERO;
+                if plan.emitting_objects {
+                    radiance += Vec3::ONE * emission_of(r, object);
+                }
+                if let Some(Material::Emissive { radiance: e }) = material_of(r, object) {
+                    radiance += Vec3::ONE * Vec3::from_array(*e);
+                }
+                return radiance;
+            }
         },
     };
     // As `sample_radiance` adds it: zero radiance plus unit throughput times what is seen.

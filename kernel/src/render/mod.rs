@@ -83,6 +83,9 @@ pub struct RenderPlan {
     /// Some object is [`Object::one_sided`]: hits on a surface's back are checked (black, the
     /// path ends).
     pub one_sided: bool,
+    /// Some object's material takes light (diffuse, mirror or glossy: anything but
+    /// [`Material::Emissive`]), so lights and reflections can change what a camera ray sees.
+    pub lit_surfaces: bool,
     /// Some radiance is found only by rays that hit it, not by sampling the lights: a
     /// background that is not black, an emissive material or an emitting object. Without it
     /// the path integrator ends a path at its last vertex once the lights are sampled.
@@ -98,19 +101,22 @@ pub struct RenderPlan {
 
 impl RenderPlan {
     /// True when camera rays are all a render casts: the direct integrator, one sample at each
-    /// pixel centre, a pinhole, nothing moving, no lights, no emissive geometry (emitting
-    /// objects or emissive materials) and nothing reflecting. The renderer then runs a first-hit loop without sample streams or a bounce
-    /// loop (the same bits).
+    /// pixel centre, a pinhole, nothing moving, and nothing a light could reach: either no
+    /// surface is lit (every object emits through its material), or there are no lights, no
+    /// emissive geometry and nothing reflecting. The renderer then runs a first-hit loop
+    /// without sample streams or a bounce loop (the same bits).
     #[must_use]
     pub const fn camera_rays_only(&self) -> bool {
+        let unlit = !self.lit_surfaces
+            || (!self.emissive_geometry
+                && !self.reflections
+                && self.point_lights == 0
+                && self.area_lights == 0);
         matches!(self.integrator, Integrator::Direct)
-            && !self.emissive_geometry
             && self.pixel_centre
             && !self.lens
             && !self.motion
-            && !self.reflections
-            && self.point_lights == 0
-            && self.area_lights == 0
+            && unlit
     }
 
     fn derive<S: SpawnScalar>(scene: &Scene<'_, S>, settings: &Settings) -> Self {
@@ -142,6 +148,13 @@ impl RenderPlan {
                 !o.shape.is_empty() && geometry::emitted_by(o, scene.materials) != [0.0; 3]
             }),
             one_sided: scene.objects.iter().any(|o| o.one_sided),
+            lit_surfaces: scene.objects.iter().any(|o| {
+                !o.shape.is_empty()
+                    && scene
+                        .materials
+                        .get(o.material as usize)
+                        .is_some_and(|m| !matches!(m, Material::Emissive { .. }))
+            }),
             unsampled_emission: emitting_objects
                 || scene.background != [0.0; 3]
                 || used(|m| matches!(m, Material::Emissive { .. })),
