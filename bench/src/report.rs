@@ -1109,7 +1109,7 @@ fn fireflies_section(s: &mut String, rows: &[FireflyRow]) {
     );
     let _ = writeln!(
         s,
-        "| integrator | pixels | count | linear median | 99th percentile | 99.9th percentile | \
+        "| integrator | region | pixels | linear median | 99th percentile | 99.9th percentile | \
          largest | display 99.9th percentile | isolated fireflies |\n\
          |---|---|---:|---:|---:|---:|---:|---:|---:|"
     );
