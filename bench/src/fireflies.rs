@@ -6,8 +6,7 @@
 //! per-pixel error distribution pooled over those renders and counts isolated fireflies.
 
 use crate::error::Error;
-use host::render::{render, RenderOptions};
-use host::trace::Mode;
+use crate::images::{render_f32, rmse};
 use raykernel::glam::DVec3;
 use raykernel::render::{encode_srgb8, scenes, Integrator, Material, SamplerKind, Settings};
 use serde::Serialize;
@@ -97,15 +96,7 @@ pub fn run(quick: bool, threads: usize) -> Result<Vec<FireflyRow>, Error> {
                 seed: data.settings.seed.wrapping_add(seed),
                 ..data.settings
             };
-            let options = RenderOptions {
-                mode: Mode::F32,
-                threads,
-                progress: false,
-                ..RenderOptions::default()
-            };
-            render(&data, settings, &options)
-                .map(|r| r.frame.linear)
-                .map_err(|e| Error::Bench(format!("fireflies: {e:?}")))
+            render_f32(&data, settings, threads).map(|r| r.frame.linear)
         };
         let reference = go(spp * 16, 0)?;
         let highlight = highlight_pixels(&sphere, &reference, size);
@@ -129,7 +120,7 @@ pub fn run(quick: bool, threads: usize) -> Result<Vec<FireflyRow>, Error> {
             let mut shown = Vec::new();
             for im in &images {
                 for &i in pixels.iter() {
-                    linear.push(linear_error(im[i], reference[i]));
+                    linear.push(rmse(&[im[i]], &[reference[i]]));
                     shown.push((display(im[i]) - display(reference[i])).abs());
                 }
             }
@@ -161,16 +152,6 @@ pub fn run(quick: bool, threads: usize) -> Result<Vec<FireflyRow>, Error> {
 /// The value at quantile `q` of sorted, non-empty `v` (nearest rank).
 fn percentile(v: &[f64], q: f64) -> f64 {
     v[((v.len() - 1) as f64 * q).round() as usize]
-}
-
-/// RMS over the channels of the linear difference.
-fn linear_error(p: [f32; 3], q: [f32; 3]) -> f64 {
-    let sum: f64 = p
-        .iter()
-        .zip(&q)
-        .map(|(x, y)| f64::from(x - y).powi(2))
-        .sum();
-    (sum / 3.0).sqrt()
 }
 
 /// Linear luminance (Rec. 709 weights).

@@ -7,9 +7,7 @@
 //! two converge to the same image (the references' difference against their noise).
 
 use crate::error::Error;
-use host::render::{render, RenderError, RenderOptions};
 use host::scenefile::dump;
-use host::trace::Mode;
 use raykernel::render::scenes::{ObjectData, SceneData, ShapeRange};
 use raykernel::render::{Camera, Filter, Integrator, Light, Material, SamplerKind, Settings};
 use serde::{Deserialize, Serialize};
@@ -295,16 +293,7 @@ pub fn run(opts: &GiOptions) -> Result<GiResults, Error> {
             sampler,
             ..data.settings
         };
-        let options = RenderOptions {
-            mode: Mode::F32,
-            threads,
-            progress: false,
-            ..RenderOptions::default()
-        };
-        render(&data, settings, &options).map_err(|e| match e {
-            RenderError::Scene(e) => Error::Bench(format!("gi-cornell: {e}")),
-            RenderError::Pool(msg) => Error::Bench(format!("cannot start threads: {msg}")),
-        })
+        crate::images::render_f32(&data, settings, threads)
     };
     eprintln!(
         "bench: global illumination: {}x{}, references {} spp",

@@ -6,7 +6,7 @@
 //! where the integrand is smooth.
 
 use crate::error::Error;
-use host::render::{render, RenderError, RenderOptions};
+use host::render::{render, RenderError, RenderOptions, Rendered};
 use host::trace::Mode;
 use raykernel::render::scenes;
 use raykernel::render::{SamplerKind, Settings};
@@ -78,18 +78,7 @@ pub fn run(opts: &ImageOptions) -> Result<Vec<ImageRow>, Error> {
         sampler,
         ..data.settings
     };
-    let go = |settings: Settings, threads: usize| {
-        let options = RenderOptions {
-            mode: Mode::F32,
-            threads,
-            progress: false,
-            ..RenderOptions::default()
-        };
-        render(&data, settings, &options).map_err(|e| match e {
-            RenderError::Scene(e) => Error::Bench(format!("{}: {e}", opts.scene)),
-            RenderError::Pool(msg) => Error::Bench(format!("cannot start threads: {msg}")),
-        })
-    };
+    let go = |settings, threads| render_f32(&data, settings, threads);
     eprintln!(
         "bench: images: {} {}x{}, reference {} spp",
         opts.scene, opts.size.0, opts.size.1, opts.reference_spp
@@ -113,6 +102,27 @@ pub fn run(opts: &ImageOptions) -> Result<Vec<ImageRow>, Error> {
         }
     }
     Ok(rows)
+}
+
+/// Renders `data` in `f32` on `threads` threads, without progress output.
+///
+/// # Errors
+/// A render the kernel refuses (named by the scene), or a thread pool that cannot start.
+pub fn render_f32(
+    data: &scenes::SceneData<'_>,
+    settings: Settings,
+    threads: usize,
+) -> Result<Rendered, Error> {
+    let options = RenderOptions {
+        mode: Mode::F32,
+        threads,
+        progress: false,
+        ..RenderOptions::default()
+    };
+    render(data, settings, &options).map_err(|e| match e {
+        RenderError::Scene(e) => Error::Bench(format!("{}: {e}", data.name)),
+        RenderError::Pool(msg) => Error::Bench(format!("cannot start threads: {msg}")),
+    })
 }
 
 /// Root mean square difference over every channel of two images of the same size.
