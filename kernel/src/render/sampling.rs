@@ -259,9 +259,9 @@ fn below_one(x: f32) -> f32 {
 pub fn tent(u: f32) -> f32 {
     let v = 2.0 * u;
     if v < 1.0 {
-        libm::sqrtf(v) - 1.0
+        crate::scalar::sqrtf(v) - 1.0
     } else {
-        1.0 - libm::sqrtf(2.0 - v)
+        1.0 - crate::scalar::sqrtf(2.0 - v)
     }
 }
 
@@ -309,7 +309,7 @@ fn erf_inv(y: f32) -> f32 {
         ];
         c.iter().fold(0.0, |p, &k| k + p * w) * y
     } else {
-        let w = libm::sqrtf(w) - 3.0;
+        let w = crate::scalar::sqrtf(w) - 3.0;
         let c = [
             -2.002_142_6e-4,
             1.009_505_6e-4,
@@ -356,7 +356,7 @@ pub fn concentric_disk(u: f32, v: f32) -> (f32, f32) {
 #[must_use]
 pub fn phong_lobe(u: f32, v: f32, exponent: f32) -> Vec3 {
     let cos_t = libm::powf(1.0 - u, 1.0 / (exponent + 1.0));
-    let sin_t = libm::sqrtf(max0(1.0 - cos_t * cos_t));
+    let sin_t = crate::scalar::sqrtf(max0(1.0 - cos_t * cos_t));
     let phi = 2.0 * PI * v;
     Vec3::new(sin_t * libm::cosf(phi), sin_t * libm::sinf(phi), cos_t)
 }
@@ -365,7 +365,7 @@ pub fn phong_lobe(u: f32, v: f32, exponent: f32) -> Vec3 {
 #[must_use]
 pub fn cosine_hemisphere(u: f32, v: f32) -> Vec3 {
     let (x, y) = concentric_disk(u, v);
-    Vec3::new(x, y, libm::sqrtf(max0(1.0 - x * x - y * y)))
+    Vec3::new(x, y, crate::scalar::sqrtf(max0(1.0 - x * x - y * y)))
 }
 
 /// A direction in the cone of half-angle `acos(cos_max)` around `+z`, uniform in solid angle
@@ -373,7 +373,7 @@ pub fn cosine_hemisphere(u: f32, v: f32) -> Vec3 {
 #[must_use]
 pub fn uniform_cone(u: f32, v: f32, cos_max: f32) -> Vec3 {
     let cos_t = 1.0 - u * (1.0 - cos_max);
-    let sin_t = libm::sqrtf(max0(1.0 - cos_t * cos_t));
+    let sin_t = crate::scalar::sqrtf(max0(1.0 - cos_t * cos_t));
     let phi = 2.0 * PI * v;
     Vec3::new(sin_t * libm::cosf(phi), sin_t * libm::sinf(phi), cos_t)
 }

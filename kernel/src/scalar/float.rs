@@ -1,7 +1,7 @@
 //! `f32` mode: conservative slab test (Ize 2013) and watertight ray/triangle test
 //! (Woop, Benthin, Wald 2013, "Watertight Ray/Triangle Intersection", JCGT 2(1)).
 //!
-//! Rounding rules: only `+ - * /` and `libm::sqrtf` (correctly rounded everywhere), no fused
+//! Rounding rules: only `+ - * /` and [`sqrtf`] (correctly rounded everywhere), no fused
 //! multiply-add, min/max as explicit comparisons. Every function is a pure function of its
 //! inputs, so a primitive gives the same bits whichever accelerator asks. No `f64` on any path
 //! of this mode on bare-metal targets (the exact parts use error-free `f32` transformations,
@@ -12,6 +12,9 @@
 mod eft;
 #[cfg(not(target_os = "none"))]
 mod rounded;
+mod sqrt;
+
+pub(crate) use sqrt::sqrtf;
 
 use super::lanes::F4;
 use super::Scalar;
@@ -68,24 +71,22 @@ fn abs(x: f32) -> f32 {
     libm::fabsf(x)
 }
 
-/// The next representable value above (`up`) or below `x`; `x` must be finite.
-fn step(x: f32, up: bool) -> f32 {
-    if x == 0.0 {
-        let tiny = f32::from_bits(1);
-        return if up { tiny } else { -tiny };
-    }
-    let bits = x.to_bits();
-    let away_from_zero = (x > 0.0) == up;
-    f32::from_bits(if away_from_zero { bits + 1 } else { bits - 1 })
-}
-
-/// `x` moved by `delta` in the given direction, and by at least one ulp.
-fn shift(x: f32, delta: f32, up: bool) -> f32 {
-    let y = if up { x + delta } else { x - delta };
-    if y == x {
-        step(x, up)
+/// How far the margin moves a coordinate of a point or box whose largest magnitude is `m`:
+/// `max(m·MARGIN, TINY)` (the smallest subnormal).
+///
+/// `x ± margin_offset(m)` for `|x| <= m` is `x` moved by `m·MARGIN`, and by at least one ulp:
+/// a non-zero `m·MARGIN` is at least 16 ulps of `x`, so the sum never rounds back to `x`; a
+/// zero one means `x` is zero or subnormal, whose neighbours are `x ± TINY` exactly. (A test
+/// checks this against stepping the bits; only the sign of a zero result can differ, which no
+/// comparison sees.) Plain arithmetic, so whole vectors of coordinates move at once.
+#[inline(always)]
+fn margin_offset(m: f32) -> f32 {
+    const TINY: f32 = f32::from_bits(1);
+    let delta = m * MARGIN;
+    if delta > TINY {
+        delta
     } else {
-        y
+        TINY
     }
 }
 
@@ -121,7 +122,7 @@ fn unit_dir(d: [f32; 3]) -> Result<[f32; 3], RayError> {
     }
     let k = recip_binade(m);
     let s = [d[0] * k, d[1] * k, d[2] * k];
-    let len = libm::sqrtf(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    let len = sqrtf(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
     // Three quotients in one vector division (each lane the same IEEE quotient).
     let q = F4::new([s[0], s[1], s[2], s[2]])
         .div(F4::splat(len))
@@ -209,25 +210,15 @@ impl FloatRay {
         })
     }
 
-    /// The origins the slab test sees (see the fields' docs), z repeated in lane 3.
-    ///
-    /// Each lane is `shift(x, delta, up)` with `delta = o_max · MARGIN`, written branch-free as
-    /// `x ± max(delta, TINY)` (the smallest subnormal): the same value, because `|x| <= o_max`
-    /// makes a non-zero `delta` at least 16 ulps of `x`, so `x ± delta` never rounds back to
-    /// `x`; and a zero `delta` means `|x|` is zero or subnormal, whose next value is `x ± TINY`
-    /// (a test checks this against `shift`; only the sign of a zero result can differ, which
-    /// no comparison sees). Plain arithmetic lets the two arrays be built and
-    /// stored as whole vectors: read back by the slab test, lane-wise stores stalled on store
-    /// forwarding.
+    /// The origins the slab test sees (see the fields' docs), z repeated in lane 3, each
+    /// coordinate moved by [`margin_offset`]. Built and stored as whole vectors: read back by
+    /// the slab test, lane-wise stores stalled on store forwarding.
     #[cfg_attr(not(target_os = "none"), inline(always))]
     fn shifted_origins(origin: [f32; 3]) -> ([f32; 4], [f32; 4]) {
-        const TINY: f32 = f32::from_bits(1);
-        let o_max = abs(origin[0]).max_of(abs(origin[1])).max_of(abs(origin[2]));
-        let delta = o_max * MARGIN;
-        let d = if delta > TINY { delta } else { TINY };
+        let d = margin_offset(abs(origin[0]).max_of(abs(origin[1])).max_of(abs(origin[2])));
         let [x, y, z] = origin;
-        // Seen from shifted origins the box grows by `delta` on each side, whichever plane is
-        // near: `lo - (o + delta)` and `hi - (o - delta)`. For a zero component an origin inside
+        // Seen from shifted origins the box grows by `d` on each side, whichever plane is
+        // near: `lo - (o + d)` and `hi - (o - d)`. For a zero component an origin inside
         // the slab then sees `-inf` and `+inf`, never `0 * inf`.
         ([x + d, y + d, z + d, z + d], [x - d, y - d, z - d, z - d])
     }
@@ -414,6 +405,9 @@ fn zero_area(v: &[[f32; 3]; 3]) -> bool {
     let e1: [f32; 3] = core::array::from_fn(|i| v[1][i] - v[0][i]);
     let e2: [f32; 3] = core::array::from_fn(|i| v[2][i] - v[0][i]);
     for (i, j) in [(1, 2), (2, 0), (0, 1)] {
+        if cfg!(target_os = "none") {
+            break;
+        }
         let (i, j) = (i.min(2), j.min(2)); // no-ops that show the compiler the bounds
         let (p, q) = (e1[i] * e2[j], e1[j] * e2[i]);
         if abs(p - q) > (abs(p) + abs(q)) * REL + ABS {
@@ -518,13 +512,8 @@ impl Scalar for f32 {
         for i in 0..3 {
             m = m.max_of(abs(lo[i])).max_of(abs(hi[i]));
         }
-        let delta = m * MARGIN;
-        let mut out = (lo, hi);
-        for i in 0..3 {
-            out.0[i] = shift(lo[i], delta, false);
-            out.1[i] = shift(hi[i], delta, true);
-        }
-        out
+        let d = margin_offset(m);
+        (lo.map(|x| x - d), hi.map(|x| x + d))
     }
 
     #[inline(always)]
@@ -670,7 +659,7 @@ impl Scalar for f32 {
             return None;
         }
         let c = f[0] * f[0] + f[1] * f[1] + f[2] * f[2] - radius * radius;
-        let q = b + libm::copysignf(libm::sqrtf(a * disc), b);
+        let q = b + libm::copysignf(sqrtf(a * disc), b);
         if q == 0.0 {
             return None; // zero radius seen from its own centre
         }
@@ -722,33 +711,56 @@ mod tests {
         assert!(step(0.0, true) > 0.0 && step(0.0, false) < 0.0);
     }
 
+    /// The next representable value above (`up`) or below `x`; `x` must be finite.
+    fn step(x: f32, up: bool) -> f32 {
+        if x == 0.0 {
+            let tiny = f32::from_bits(1);
+            return if up { tiny } else { -tiny };
+        }
+        let bits = x.to_bits();
+        let away_from_zero = (x > 0.0) == up;
+        f32::from_bits(if away_from_zero { bits + 1 } else { bits - 1 })
+    }
+
+    /// `x` moved by `delta` in the given direction, and by at least one ulp: what
+    /// [`margin_offset`] promises, the long way.
+    fn shift(x: f32, delta: f32, up: bool) -> f32 {
+        let y = if up { x + delta } else { x - delta };
+        if y == x {
+            step(x, up)
+        } else {
+            y
+        }
+    }
+
+    /// Magnitudes of every kind: zeros, subnormals, the normal threshold, up to the limit.
+    const COORDS: [f32; 19] = [
+        0.0,
+        -0.0,
+        f32::from_bits(1),
+        -f32::from_bits(1),
+        3.0 * f32::from_bits(1),
+        1e-40,
+        -1e-39,
+        1.17e-38,
+        1e-30,
+        1e-20,
+        0.5,
+        1.0,
+        -1.0,
+        3.0,
+        1234.5,
+        -1e6,
+        7.3e11,
+        F32_COORD_LIMIT,
+        -F32_COORD_LIMIT,
+    ];
+
     #[test]
     fn shifted_origins_move_each_lane_as_shift_does() {
-        let tiny = f32::from_bits(1);
-        let values = [
-            0.0,
-            -0.0,
-            tiny,
-            -tiny,
-            3.0 * tiny,
-            1e-40,
-            -1e-39,
-            1.17e-38,
-            1e-30,
-            1e-20,
-            0.5,
-            1.0,
-            -1.0,
-            3.0,
-            1234.5,
-            -1e6,
-            7.3e11,
-            F32_COORD_LIMIT,
-            -F32_COORD_LIMIT,
-        ];
-        for &a in &values {
-            for &b in &values {
-                for &c in &values {
+        for &a in &COORDS {
+            for &b in &COORDS {
+                for &c in &COORDS {
                     let origin = [a, b, c];
                     let o_max = abs(a).max_of(abs(b)).max_of(abs(c));
                     let delta = o_max * MARGIN;
@@ -760,6 +772,28 @@ mod tests {
                         assert!(hi[i] == shift(x, delta, false) && hi[i] < x, "{origin:?}");
                     }
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn padded_bounds_move_each_coordinate_as_shift_does() {
+        let mut st = 0x9add_0000_0000_0001u64;
+        for _ in 0..100_000 {
+            let mut pick = || {
+                st ^= st << 13;
+                st ^= st >> 7;
+                st ^= st << 17;
+                COORDS[(st % COORDS.len() as u64) as usize]
+            };
+            let (p, q): ([f32; 3], [f32; 3]) = ([pick(), pick(), pick()], [pick(), pick(), pick()]);
+            let lo: [f32; 3] = core::array::from_fn(|i| p[i].min_of(q[i]));
+            let hi: [f32; 3] = core::array::from_fn(|i| p[i].max_of(q[i]));
+            let m = (0..3).fold(0.0f32, |m, i| m.max_of(abs(lo[i])).max_of(abs(hi[i])));
+            let (plo, phi) = <f32 as Scalar>::pad_bounds(lo, hi);
+            for i in 0..3 {
+                assert!(plo[i] == shift(lo[i], m * MARGIN, false) && plo[i] < lo[i]);
+                assert!(phi[i] == shift(hi[i], m * MARGIN, true) && phi[i] > hi[i]);
             }
         }
     }
