@@ -91,14 +91,15 @@ fn margin_offset(m: f32) -> f32 {
 }
 
 fn check_coord(x: f32) -> Result<(), PointError> {
-    if !x.is_finite() {
-        Err(PointError::NonFinite)
-    } else if abs(x) > F32_COORD_LIMIT {
+    // One comparison on the common path: it fails for NaN and infinities too.
+    if abs(x) <= F32_COORD_LIMIT {
+        Ok(())
+    } else if x.is_finite() {
         Err(PointError::OutOfRange {
             limit: F32_COORD_LIMIT,
         })
     } else {
-        Ok(())
+        Err(PointError::NonFinite)
     }
 }
 
