@@ -600,11 +600,13 @@ impl Scalar for f32 {
 
     #[inline(always)]
     fn triangle_t(r: &FloatRay, v: &[[f32; 3]; 3], t_min: f32, t_max: f32) -> Option<f32> {
-        // Translate to the ray origin, permute so the dominant axis is z, and shear.
-        let [a, b, c] = r.sheared(v);
+        // Translate to the ray origin, permute so the dominant axis is z, and shear. (Borrowed
+        // from one array: destructured by value, the vertices were copied on bare metal.)
+        let sheared = r.sheared(v);
+        let [a, b, c] = &sheared;
         // Edge functions; two-sided, so reject only if the signs differ. (Non-short-circuit
         // operators: one branch instead of six hard-to-predict ones.)
-        let [eu, ev, ew] = FloatRay::edges(&a, &b, &c);
+        let [eu, ev, ew] = FloatRay::edges(a, b, c);
         let negative = (eu < 0.0) | (ev < 0.0) | (ew < 0.0);
         let positive = (eu > 0.0) | (ev > 0.0) | (ew > 0.0);
         if negative & positive {
@@ -616,7 +618,7 @@ impl Scalar for f32 {
         // The signs above decide hit or miss (watertight). For the distance, recompute the
         // edge functions with exact products (double-f32): on slivers the f32 values keep too
         // few bits for an accurate t. Rare path: candidates only.
-        let t = FloatRay::candidate_t(&a, &b, &c)?;
+        let t = FloatRay::candidate_t(a, b, c)?;
         if !(t >= t_min && t <= t_max) {
             return None;
         }
@@ -628,11 +630,12 @@ impl Scalar for f32 {
     }
 
     fn triangle_uv(r: &FloatRay, v: &[[f32; 3]; 3]) -> (f32, f32) {
-        let [a, b, c] = r.sheared(v);
+        let sheared = r.sheared(v);
+        let [a, b, c] = &sheared;
         // Clamped to [0, 1] as in fixed point: the exact solve can disagree in sign with the f32
         // edge functions that accepted the hit by a few subnormals (found by fuzzing).
         let unit = |w: f32| if w > 0.0 { w.min_of(1.0) } else { 0.0 };
-        FloatRay::solve(&a, &b, &c).map_or((0.0, 0.0), |(_, u, v)| (unit(u), unit(v)))
+        FloatRay::solve(a, b, c).map_or((0.0, 0.0), |(_, u, v)| (unit(u), unit(v)))
     }
 
     fn sphere_t(
