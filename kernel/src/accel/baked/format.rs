@@ -177,11 +177,16 @@ pub(crate) fn word(bytes: &[u8], offset: usize) -> u32 {
 /// [`BakeError::UnsupportedVersion`], [`BakeError::BadField`], [`BakeError::WrongLength`] (with the field's offset),
 /// [`BakeError::BadChecksum`].
 pub fn read_header(bytes: &[u8]) -> Result<Header, BakeError> {
-    checked_header(bytes).map(|(header, _)| header)
+    checked_header(bytes, None).map(|(header, _)| header)
 }
 
-/// [`read_header`], with the section layout it checked the header against.
-pub(crate) fn checked_header(bytes: &[u8]) -> Result<(Header, Layout), BakeError> {
+/// [`read_header`], with the section layout it checked the header against. With `expect`,
+/// a file of another mode or kind is refused as soon as those fields are read
+/// ([`BakeError::WrongStructure`]), so a loader links the checks of its own kind only.
+pub(crate) fn checked_header(
+    bytes: &[u8],
+    expect: Option<(BakedMode, BakedKind)>,
+) -> Result<(Header, Layout), BakeError> {
     if bytes.len() < HEADER_LEN {
         return Err(BakeError::Truncated {
             needed: HEADER_LEN,
@@ -212,6 +217,9 @@ pub(crate) fn checked_header(bytes: &[u8]) -> Result<(Header, Layout), BakeError
         2 => BakedKind::Bvh4,
         _ => return Err(bad(field::KIND)),
     };
+    if expect.is_some_and(|wanted| wanted != (mode, kind)) {
+        return Err(BakeError::WrongStructure);
+    }
     let flags = word(bytes, field::FLAGS);
     if flags & !FLAG_LEAF_ORDER != 0 {
         return Err(bad(field::FLAGS));

@@ -45,10 +45,7 @@ fn sections<S: BakedScalar, N: Plain>(
     bytes: &[u8],
     kind: BakedKind,
 ) -> Result<(Header, &[N], &[u32], &[Triangle<S>]), BakeError> {
-    let (header, layout) = checked_header(bytes)?;
-    if header.mode != S::MODE || header.kind != kind {
-        return Err(BakeError::WrongStructure);
-    }
+    let (header, layout) = checked_header(bytes, Some((S::MODE, kind)))?;
     if cfg!(target_endian = "big") {
         return Err(BakeError::BigEndianTarget);
     }
