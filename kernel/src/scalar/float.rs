@@ -406,9 +406,6 @@ fn zero_area(v: &[[f32; 3]; 3]) -> bool {
     let e1: [f32; 3] = core::array::from_fn(|i| v[1][i] - v[0][i]);
     let e2: [f32; 3] = core::array::from_fn(|i| v[2][i] - v[0][i]);
     for (i, j) in [(1, 2), (2, 0), (0, 1)] {
-        if cfg!(target_os = "none") {
-            break;
-        }
         let (i, j) = (i.min(2), j.min(2)); // no-ops that show the compiler the bounds
         let (p, q) = (e1[i] * e2[j], e1[j] * e2[i]);
         if abs(p - q) > (abs(p) + abs(q)) * REL + ABS {
