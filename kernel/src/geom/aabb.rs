@@ -30,7 +30,7 @@ impl<S: Scalar> Aabb<S> {
     /// True if `o` lies inside `self` (boundaries included).
     #[must_use]
     pub fn contains(&self, o: &Self) -> bool {
-        (0..3).all(|i| self.lo[i] <= o.lo[i] && o.hi[i] <= self.hi[i])
+        corners_contain((&self.lo, &self.hi), (&o.lo, &o.hi))
     }
 
     /// Conservative slab test: the entry distance if the ray's interval meets the box.
@@ -43,4 +43,13 @@ impl<S: Scalar> Aabb<S> {
     pub fn slab(&self, ray: &Ray<S>) -> Option<S> {
         S::slab(ray.data(), &self.lo, &self.hi, ray.t_min(), ray.t_max())
     }
+}
+
+/// [`Aabb::contains`] on corners where they are stored (a node's, say), so no box is copied to
+/// ask: true if the box `inner_lo..inner_hi` lies inside `lo..hi`, boundaries included.
+pub(crate) fn corners_contain<S: Scalar>(
+    (lo, hi): (&[S; 3], &[S; 3]),
+    (inner_lo, inner_hi): (&[S; 3], &[S; 3]),
+) -> bool {
+    (0..3).all(|i| lo[i] <= inner_lo[i] && inner_hi[i] <= hi[i])
 }

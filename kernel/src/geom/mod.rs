@@ -6,6 +6,7 @@ mod primitive;
 mod ray;
 pub mod spawn;
 
+pub(crate) use aabb::corners_contain;
 pub use aabb::Aabb;
 pub use hit::{closer, Hit};
 pub use primitive::{Primitive, Sphere, Triangle};

@@ -23,6 +23,7 @@ use super::Renderer;
 use crate::accel::AccelFamily;
 use crate::geom::spawn::SpawnScalar;
 use crate::geom::Triangle;
+use crate::scalar::sqrtf;
 use core::f32::consts::PI;
 use glam::Vec3;
 
@@ -97,7 +98,7 @@ pub(super) fn sample<S: SpawnScalar, F: AccelFamily<S>>(
             let twice_area = cross.length();
             let to = y - pf;
             let d2 = to.length_squared();
-            let dist = crate::scalar::sqrtf(d2);
+            let dist = sqrtf(d2);
             let cos = nf.dot(to) / dist;
             let front = -cross.dot(to) / (twice_area * dist);
             let cos_l = if o.one_sided {
@@ -133,8 +134,8 @@ pub(super) fn sample<S: SpawnScalar, F: AccelFamily<S>>(
             if dc2 <= r2 * ON_SPHERE || dc2.is_nan() {
                 return None;
             }
-            let dc = crate::scalar::sqrtf(dc2);
-            let cos_max = crate::scalar::sqrtf(1.0 - r2 / dc2);
+            let dc = sqrtf(dc2);
+            let cos_max = sqrtf(1.0 - r2 / dc2);
             let wi = to_world(uniform_cone(a, b, cos_max), to_c / dc);
             let cos = nf.dot(wi);
             if cos <= 0.0 || cos.is_nan() {
@@ -143,7 +144,7 @@ pub(super) fn sample<S: SpawnScalar, F: AccelFamily<S>>(
             // Nearest root of |p + t·wi − c| = r (the cone guarantees one, up to rounding).
             let b_half = wi.dot(to_c);
             let disc = b_half * b_half - (dc2 - r2);
-            let t = b_half - crate::scalar::sqrtf(if disc > 0.0 { disc } else { 0.0 });
+            let t = b_half - sqrtf(if disc > 0.0 { disc } else { 0.0 });
             let inv_density = count * (2.0 * PI * (1.0 - cos_max));
             let (w, bsdf_pdf) = lobe.weigh(wi, 1.0, cos);
             let c = le * (w * inv_density);
@@ -208,7 +209,7 @@ pub(super) fn density<S: SpawnScalar, F: AccelFamily<S>>(
             if dc2 <= r2 * ON_SPHERE || dc2.is_nan() {
                 return 0.0;
             }
-            let cos_max = crate::scalar::sqrtf(1.0 - r2 / dc2);
+            let cos_max = sqrtf(1.0 - r2 / dc2);
             1.0 / (count * (2.0 * PI * (1.0 - cos_max)))
         }
         Shape::Spheres(_) => 0.0,

@@ -12,6 +12,7 @@ use super::{RenderStats, Renderer};
 use crate::accel::{AccelFamily, NoStats};
 use crate::geom::spawn::{shadow_t_max, SpawnScalar};
 use crate::geom::Ray;
+use crate::scalar::sqrtf;
 use core::f32::consts::{FRAC_1_PI, PI};
 use glam::Vec3;
 
@@ -91,7 +92,7 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
             } => {
                 let to = Vec3::from_array(position) - pf;
                 let d2 = to.length_squared();
-                let dist = crate::scalar::sqrtf(d2);
+                let dist = sqrtf(d2);
                 let cos = nf.dot(to) / dist;
                 if !(cos > 0.0 && d2 > 0.0) {
                     continue;
@@ -110,7 +111,7 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
                 let y = Vec3::from_array(corner) + eu * a + ev * b;
                 let to = y - pf;
                 let d2 = to.length_squared();
-                let dist = crate::scalar::sqrtf(d2);
+                let dist = sqrtf(d2);
                 let cross = eu.cross(ev);
                 let area = cross.length();
                 let cos = nf.dot(to) / dist;
@@ -139,9 +140,9 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
                 if dc2 <= r2 || dc2.is_nan() {
                     continue;
                 }
-                let dc = crate::scalar::sqrtf(dc2);
+                let dc = sqrtf(dc2);
                 let axis = to_c / dc;
-                let cos_max = crate::scalar::sqrtf(1.0 - r2 / dc2);
+                let cos_max = sqrtf(1.0 - r2 / dc2);
                 let wi = to_world(uniform_cone(a, b, cos_max), axis);
                 let cos = nf.dot(wi);
                 if cos <= 0.0 || cos.is_nan() {
@@ -150,7 +151,7 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
                 // Nearest root of |p + t·wi − c| = r (the cone guarantees one, up to rounding).
                 let b_half = wi.dot(to_c);
                 let disc = b_half * b_half - (dc2 - r2);
-                let t = b_half - crate::scalar::sqrtf(if disc > 0.0 { disc } else { 0.0 });
+                let t = b_half - sqrtf(if disc > 0.0 { disc } else { 0.0 });
                 let solid_angle = 2.0 * PI * (1.0 - cos_max);
                 let (w, bsdf_pdf) = lobe.weigh(wi, 1.0, cos);
                 let c = Vec3::from_array(radiance) * (w * solid_angle);
@@ -245,7 +246,7 @@ pub(super) fn light_pdf<S: SpawnScalar, F: AccelFamily<S>>(
             if dc2 <= r2 || dc2.is_nan() {
                 return 0.0;
             }
-            let cos_max = crate::scalar::sqrtf(1.0 - r2 / dc2);
+            let cos_max = sqrtf(1.0 - r2 / dc2);
             1.0 / (2.0 * PI * (1.0 - cos_max))
         }
         _ => 0.0,

@@ -13,6 +13,7 @@
 //!   a scrambled sample order per dimension pair (Burley 2020, "Practical Hash-based Owen
 //!   Scrambling"): no tables, low discrepancy at every power-of-two sample count.
 
+use crate::scalar::sqrtf;
 use core::f32::consts::PI;
 use core::num::NonZeroU32;
 use glam::Vec3;
@@ -259,9 +260,9 @@ fn below_one(x: f32) -> f32 {
 pub fn tent(u: f32) -> f32 {
     let v = 2.0 * u;
     if v < 1.0 {
-        crate::scalar::sqrtf(v) - 1.0
+        sqrtf(v) - 1.0
     } else {
-        1.0 - crate::scalar::sqrtf(2.0 - v)
+        1.0 - sqrtf(2.0 - v)
     }
 }
 
@@ -309,7 +310,7 @@ fn erf_inv(y: f32) -> f32 {
         ];
         c.iter().fold(0.0, |p, &k| k + p * w) * y
     } else {
-        let w = crate::scalar::sqrtf(w) - 3.0;
+        let w = sqrtf(w) - 3.0;
         let c = [
             -2.002_142_6e-4,
             1.009_505_6e-4,
@@ -356,7 +357,7 @@ pub fn concentric_disk(u: f32, v: f32) -> (f32, f32) {
 #[must_use]
 pub fn phong_lobe(u: f32, v: f32, exponent: f32) -> Vec3 {
     let cos_t = libm::powf(1.0 - u, 1.0 / (exponent + 1.0));
-    let sin_t = crate::scalar::sqrtf(max0(1.0 - cos_t * cos_t));
+    let sin_t = sqrtf(max0(1.0 - cos_t * cos_t));
     let phi = 2.0 * PI * v;
     Vec3::new(sin_t * libm::cosf(phi), sin_t * libm::sinf(phi), cos_t)
 }
@@ -365,7 +366,7 @@ pub fn phong_lobe(u: f32, v: f32, exponent: f32) -> Vec3 {
 #[must_use]
 pub fn cosine_hemisphere(u: f32, v: f32) -> Vec3 {
     let (x, y) = concentric_disk(u, v);
-    Vec3::new(x, y, crate::scalar::sqrtf(max0(1.0 - x * x - y * y)))
+    Vec3::new(x, y, sqrtf(max0(1.0 - x * x - y * y)))
 }
 
 /// A direction in the cone of half-angle `acos(cos_max)` around `+z`, uniform in solid angle
@@ -373,7 +374,7 @@ pub fn cosine_hemisphere(u: f32, v: f32) -> Vec3 {
 #[must_use]
 pub fn uniform_cone(u: f32, v: f32, cos_max: f32) -> Vec3 {
     let cos_t = 1.0 - u * (1.0 - cos_max);
-    let sin_t = crate::scalar::sqrtf(max0(1.0 - cos_t * cos_t));
+    let sin_t = sqrtf(max0(1.0 - cos_t * cos_t));
     let phi = 2.0 * PI * v;
     Vec3::new(sin_t * libm::cosf(phi), sin_t * libm::sinf(phi), cos_t)
 }

@@ -597,8 +597,8 @@ impl Scalar for f32 {
 
     #[inline(always)]
     fn triangle_t(r: &FloatRay, v: &[[f32; 3]; 3], t_min: f32, t_max: f32) -> Option<f32> {
-        // Translate to the ray origin, permute so the dominant axis is z, and shear. (Borrowed
-        // from one array: destructured by value, the vertices were copied on bare metal.)
+        // Translate to the ray origin, permute so the dominant axis is z, and shear. (Borrowed:
+        // destructuring the array by value copies the vertices on bare metal.)
         let sheared = r.sheared(v);
         let [a, b, c] = &sheared;
         // Edge functions; two-sided, so reject only if the signs differ. (Non-short-circuit
@@ -712,6 +712,14 @@ mod tests {
         assert!(step(0.0, true) > 0.0 && step(0.0, false) < 0.0);
     }
 
+    /// The tests' xorshift generator: advances `state` and returns it.
+    fn next(state: &mut u64) -> u64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        *state
+    }
+
     /// The next representable value above (`up`) or below `x`; `x` must be finite.
     fn step(x: f32, up: bool) -> f32 {
         if x == 0.0 {
@@ -781,12 +789,7 @@ mod tests {
     fn padded_bounds_move_each_coordinate_as_shift_does() {
         let mut st = 0x9add_0000_0000_0001u64;
         for _ in 0..100_000 {
-            let mut pick = || {
-                st ^= st << 13;
-                st ^= st >> 7;
-                st ^= st << 17;
-                COORDS[(st % COORDS.len() as u64) as usize]
-            };
+            let mut pick = || COORDS[(next(&mut st) % COORDS.len() as u64) as usize];
             let (p, q): ([f32; 3], [f32; 3]) = ([pick(), pick(), pick()], [pick(), pick(), pick()]);
             let lo: [f32; 3] = core::array::from_fn(|i| p[i].min_of(q[i]));
             let hi: [f32; 3] = core::array::from_fn(|i| p[i].max_of(q[i]));
@@ -804,14 +807,8 @@ mod tests {
     /// at mixed depths, and on exactly representable depths.
     fn candidates(count: usize) -> impl Iterator<Item = [[f32; 3]; 3]> {
         let mut state = 0x0f11_7e12_0000_0001u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
         (0..count).map(move |i| {
-            let mut unit = || (next() >> 40) as f32 / 16_777_216.0 * 2.0 - 1.0;
+            let mut unit = || (next(&mut state) >> 40) as f32 / 16_777_216.0 * 2.0 - 1.0;
             let scale = libm::exp2f((i % 61) as f32 - 30.0);
             let depth = libm::exp2f((i % 23) as f32 - 8.0) * if i % 5 == 0 { -1.0 } else { 1.0 };
             let mut v = [[0.0f32; 3]; 3];
@@ -861,12 +858,6 @@ mod tests {
 
     #[test]
     fn slab_box_is_one_lane_of_slab_pair() {
-        fn next(state: &mut u64) -> u64 {
-            *state ^= *state << 13;
-            *state ^= *state >> 7;
-            *state ^= *state << 17;
-            *state
-        }
         // Coordinates on a coarse grid, so rays start on planes and run along them (zero
         // direction components: the NaN cases of the slab test) as often as not.
         fn coord(state: &mut u64) -> f32 {

@@ -1,7 +1,7 @@
 //! Structural checker for a built tree, called by tests after every build.
 
 use super::{leaf_bounds, Bvh, MAX_DEPTH, MAX_LEAF_SIZE};
-use crate::geom::Primitive;
+use crate::geom::{corners_contain, Primitive};
 use crate::scalar::Scalar;
 use core::fmt;
 
@@ -113,7 +113,9 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                 stats.max_leaf_size = stats.max_leaf_size.max(node.count);
                 let leaf = (self.prim_ids, self.prims, self.leaf_order);
                 // `None` only for a range or id out of bounds, ruled out above.
-                if !leaf_bounds(leaf, (first, count)).is_some_and(|b| holds(node, &b.lo, &b.hi)) {
+                if !leaf_bounds(leaf, (first, count))
+                    .is_some_and(|b| corners_contain((&node.lo, &node.hi), (&b.lo, &b.hi)))
+                {
                     return Err(InvalidTree::LeafTooSmall { node: index });
                 }
                 continue;
@@ -126,7 +128,7 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                 let Some(c) = self.nodes.get(child) else {
                     return Err(InvalidTree::BadChild { node: index });
                 };
-                if !holds(node, &c.lo, &c.hi) {
+                if !corners_contain((&node.lo, &node.hi), (&c.lo, &c.hi)) {
                     return Err(InvalidTree::ChildOutsideParent { node: child });
                 }
                 if stack.push((child as u32, depth as u32 + 1)).is_err() {
@@ -142,12 +144,6 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
         }
         Ok(stats)
     }
-}
-
-/// True if the box `lo..hi` lies inside `node`'s (boundaries included): [`crate::Aabb::contains`]
-/// on the node's corners in place (a box built from them was copied on bare metal).
-fn holds<S: Scalar>(node: &super::Node<S>, lo: &[S; 3], hi: &[S; 3]) -> bool {
-    (0..3).all(|i| node.lo[i] <= lo[i] && hi[i] <= node.hi[i])
 }
 
 /// Every id in `0..ids.len()` exactly once: each in range and none twice (`n` distinct ids
