@@ -30,7 +30,9 @@
 //! assert_eq!((hit.t, hit.prim), (5.0, 0));
 //! ```
 #![no_std]
-// The one exception: SSE and NEON intrinsics in `scalar/lanes.rs` (see there).
+// Exceptions, each confined and documented where it is: SSE and NEON intrinsics
+// (`scalar/lanes.rs`), the in-place view of checked baked bytes (`accel/baked/plain.rs`) and
+// the square-root instruction of Cortex-M cores with an FPU (`scalar/float/sqrt.rs`).
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 

@@ -52,23 +52,48 @@ pub struct FloatRay {
     o_lo: [f32; 4],
     /// Origin as seen from the boxes' `hi` planes: moved down by the margin.
     o_hi: [f32; 4],
-    /// Watertight test: axis permutation (kx, ky, kz), each < 3.
-    k: [u32; 3],
+    /// Watertight test: axis permutation (kx, ky, kz).
+    k: [Axis; 3],
     /// Watertight test: shear constants Sx, Sy, Sz.
     shear: [f32; 3],
     /// The origin permuted to (kx, ky, kz).
     o_perm: [f32; 3],
 }
 
-/// `v[k]` for an axis `k < 3` (every `k` of a [`FloatRay`]); `min` shows the compiler the
-/// bound, so no panic path remains.
+/// A coordinate axis. As an index it is below 3 by its type, so indexing a 3-vector with it
+/// needs no bounds check. (A word wide, as every other field of [`FloatRay`].)
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+enum Axis {
+    X = 0,
+    Y = 1,
+    Z = 2,
+}
+
+impl Axis {
+    /// The two other axes, in cyclic order after `self`.
+    fn following(self) -> (Axis, Axis) {
+        const CYCLE: [Axis; 5] = [Axis::X, Axis::Y, Axis::Z, Axis::X, Axis::Y];
+        (CYCLE[self as usize + 1], CYCLE[self as usize + 2])
+    }
+}
+
+/// `v[k]`.
 #[inline(always)]
-fn axis(v: &[f32; 3], k: u32) -> f32 {
-    v[(k as usize).min(2)]
+fn axis(v: &[f32; 3], k: Axis) -> f32 {
+    v[k as usize]
 }
 
 fn abs(x: f32) -> f32 {
     libm::fabsf(x)
+}
+
+/// The largest `|x|` of `values`, `0` for none (NaN-free inputs, as every caller's are).
+/// Inlined on hosted targets (speed); bare-metal targets keep one copy (flash).
+#[cfg_attr(not(target_os = "none"), inline(always))]
+#[cfg_attr(target_os = "none", inline(never))]
+fn max_abs(values: &[f32]) -> f32 {
+    values.iter().fold(0.0, |m, &x| m.max_of(abs(x)))
 }
 
 /// How far the margin moves a coordinate of a point or box whose largest magnitude is `m`:
@@ -117,7 +142,7 @@ fn unit_dir(d: [f32; 3]) -> Result<[f32; 3], RayError> {
     if !(d[0].is_finite() && d[1].is_finite() && d[2].is_finite()) {
         return Err(RayError::NonFiniteDirection);
     }
-    let m = abs(d[0]).max_of(abs(d[1])).max_of(abs(d[2]));
+    let m = max_abs(&d);
     if m == 0.0 {
         return Err(RayError::ZeroDirection);
     }
@@ -185,20 +210,19 @@ impl FloatRay {
         // Watertight test: kz is the dominant axis; swapping kx/ky keeps the winding.
         let a = [abs(dir[0]), abs(dir[1]), abs(dir[2])];
         let kz = if a[0] >= a[1] && a[0] >= a[2] {
-            0
+            Axis::X
         } else if a[1] >= a[2] {
-            1
+            Axis::Y
         } else {
-            2
+            Axis::Z
         };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if dir[kz] < 0.0 {
+        let (mut kx, mut ky) = kz.following();
+        if axis(&dir, kz) < 0.0 {
             core::mem::swap(&mut kx, &mut ky);
         }
-        let sz = inv[kz]; // 1 / dir[kz], the same quotient
-        let shear = [dir[kx] * sz, dir[ky] * sz, sz];
-        let k = [kx as u32, ky as u32, kz as u32];
+        let sz = inv[kz as usize]; // 1 / dir[kz], the same quotient
+        let shear = [axis(&dir, kx) * sz, axis(&dir, ky) * sz, sz];
+        let k = [kx, ky, kz];
         Ok(Self {
             origin,
             dir,
@@ -207,7 +231,7 @@ impl FloatRay {
             o_hi,
             k,
             shear,
-            o_perm: [origin[kx], origin[ky], origin[kz]],
+            o_perm: [axis(&origin, kx), axis(&origin, ky), axis(&origin, kz)],
         })
     }
 
@@ -216,7 +240,7 @@ impl FloatRay {
     /// the slab test, lane-wise stores stalled on store forwarding.
     #[cfg_attr(not(target_os = "none"), inline(always))]
     fn shifted_origins(origin: [f32; 3]) -> ([f32; 4], [f32; 4]) {
-        let d = margin_offset(abs(origin[0]).max_of(abs(origin[1])).max_of(abs(origin[2])));
+        let d = margin_offset(max_abs(&origin));
         let [x, y, z] = origin;
         // Seen from shifted origins the box grows by `d` on each side, whichever plane is
         // near: `lo - (o + d)` and `hi - (o - d)`. For a zero component an origin inside
@@ -279,12 +303,7 @@ impl FloatRay {
     /// brute force would report.
     #[inline(always)]
     fn point_near_box(&self, t: f32, v: &[[f32; 3]; 3]) -> bool {
-        let mut m = abs(self.origin[0])
-            .max_of(abs(self.origin[1]))
-            .max_of(abs(self.origin[2]));
-        for p in v {
-            m = m.max_of(abs(p[0])).max_of(abs(p[1])).max_of(abs(p[2]));
-        }
+        let m = max_abs(&self.origin).max_of(max_abs(v.as_flattened()));
         let e = m * (MARGIN * 0.5);
         let [a, b, c] = v;
         (0..3).all(|i| {
@@ -312,10 +331,7 @@ impl FloatRay {
     #[cfg_attr(not(target_os = "none"), inline(always))]
     #[cfg_attr(target_os = "none", inline(never))]
     fn scaled(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> Option<([Df; 3], Df, Df)> {
-        let mut m = 0.0f32;
-        for p in [a, b, c] {
-            m = m.max_of(abs(p[0])).max_of(abs(p[1]));
-        }
+        let m = max_abs(&[a[0], a[1], b[0], b[1], c[0], c[1]]);
         if m == 0.0 {
             return None; // every vertex on the ray's line
         }
@@ -348,10 +364,11 @@ impl FloatRay {
         Some((num.div(det), v.div(det), w.div(det)))
     }
 
-    /// The distance of [`FloatRay::solve`] alone, out of line: the rare path of every
-    /// triangle test, kept out of the traversal loops. Hosted targets first try the same
-    /// `f32` through `f64` ([`rounded::certified_t`]).
-    #[inline(never)]
+    /// The distance of [`FloatRay::solve`] alone: the rare path of every triangle test, kept
+    /// out of the traversal loops on hosted targets (speed), which first try the same `f32`
+    /// through `f64` ([`rounded::certified_t`]); bare-metal targets leave inlining to the
+    /// optimiser (flash).
+    #[cfg_attr(not(target_os = "none"), inline(never))]
     fn candidate_t(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> Option<f32> {
         #[cfg(not(target_os = "none"))]
         if let Some(t) = rounded::certified_t(a, b, c) {
@@ -392,33 +409,40 @@ fn exact_edge(p: &[f32; 3], q: &[f32; 3]) -> f32 {
     )
 }
 
-/// True if the triangle has exactly zero area: `(b - a) × (c - a) = 0`.
-///
-/// Each component is first evaluated in `f32`; one whose magnitude exceeds its rounding
-/// error bound (differences, products and their difference: under `4·2^-24` of the products'
-/// magnitudes, bounded here by `2^-21` of them plus `2^-120` for underflow) is surely
-/// non-zero. Otherwise the component is decided exactly, expanded into the six products of
-/// coordinates it equals (`a_i·b_j - a_j·b_i + b_i·c_j - b_j·c_i + c_i·a_j - c_j·a_i`), by
-/// [`exact_sum_of_products`].
+/// True if the triangle has exactly zero area: `(b - a) × (c - a) = 0`. Each component is
+/// first evaluated in `f32` ([`surely_non_zero`]); only if none is surely non-zero are they
+/// decided exactly ([`exactly_zero`]).
+#[inline(always)]
 fn zero_area(v: &[[f32; 3]; 3]) -> bool {
+    const COMPONENTS: [(usize, usize); 3] = [(1, 2), (2, 0), (0, 1)];
+    !COMPONENTS.iter().any(|&(i, j)| surely_non_zero(v, i, j))
+        && COMPONENTS.iter().all(|&(i, j)| exactly_zero(v, i, j))
+}
+
+/// True if component `(i, j)` of `(b - a) × (c - a)` evaluated in `f32` exceeds its rounding
+/// error bound (differences, products and their difference: under `4·2^-24` of the products'
+/// magnitudes, bounded here by `2^-21` of them plus `2^-120` for underflow), so is surely
+/// non-zero. Inlined on hosted targets (speed); bare-metal targets keep one copy (flash).
+#[cfg_attr(not(target_os = "none"), inline(always))]
+#[cfg_attr(target_os = "none", inline(never))]
+fn surely_non_zero(v: &[[f32; 3]; 3], i: usize, j: usize) -> bool {
     const REL: f32 = 1.0 / 2_097_152.0; // 2^-21
     const ABS: f32 = 7.523_164e-37; // 2^-120
-    let e1: [f32; 3] = core::array::from_fn(|i| v[1][i] - v[0][i]);
-    let e2: [f32; 3] = core::array::from_fn(|i| v[2][i] - v[0][i]);
-    for (i, j) in [(1, 2), (2, 0), (0, 1)] {
-        let (i, j) = (i.min(2), j.min(2)); // no-ops that show the compiler the bounds
-        let (p, q) = (e1[i] * e2[j], e1[j] * e2[i]);
-        if abs(p - q) > (abs(p) + abs(q)) * REL + ABS {
-            return false;
-        }
-    }
+    let (i, j) = (i.min(2), j.min(2)); // no-ops that show the compiler the bounds
     let [a, b, c] = v;
-    [(1, 2), (2, 0), (0, 1)].iter().all(|&(i, j)| {
-        let (i, j) = (i.min(2), j.min(2)); // as above
-        let x = [a[i], -a[j], b[i], -b[j], c[i], -c[j]];
-        let y = [b[j], b[i], c[j], c[i], a[j], a[i]];
-        exact_sum_of_products(x, y) == 0.0
-    })
+    let (p, q) = ((b[i] - a[i]) * (c[j] - a[j]), (b[j] - a[j]) * (c[i] - a[i]));
+    abs(p - q) > (abs(p) + abs(q)) * REL + ABS
+}
+
+/// True if component `(i, j)` of `(b - a) × (c - a)` is exactly zero, decided by
+/// [`exact_sum_of_products`] over the six products of coordinates it equals
+/// (`a_i·b_j - a_j·b_i + b_i·c_j - b_j·c_i + c_i·a_j - c_j·a_i`).
+fn exactly_zero(v: &[[f32; 3]; 3], i: usize, j: usize) -> bool {
+    let (i, j) = (i.min(2), j.min(2)); // as above
+    let [a, b, c] = v;
+    let x = [a[i], -a[j], b[i], -b[j], c[i], -c[j]];
+    let y = [b[j], b[i], c[j], c[i], a[j], a[i]];
+    exact_sum_of_products(x, y) == 0.0
 }
 
 /// The slab test of one box: the IEEE operations of one lane of [`Scalar::slab_pair`], in the
@@ -506,11 +530,7 @@ impl Scalar for f32 {
     }
 
     fn pad_bounds(lo: [f32; 3], hi: [f32; 3]) -> ([f32; 3], [f32; 3]) {
-        let mut m = 0.0f32;
-        for i in 0..3 {
-            m = m.max_of(abs(lo[i])).max_of(abs(hi[i]));
-        }
-        let d = margin_offset(m);
+        let d = margin_offset(max_abs(&lo).max_of(max_abs(&hi)));
         (lo.map(|x| x - d), hi.map(|x| x + d))
     }
 

@@ -12,12 +12,8 @@
 //! Inlining is forced on hosted targets only (speed); bare-metal targets (`target_os =
 //! "none"`) leave it to the optimiser, which keeps one copy of the larger helpers (flash).
 
+use super::max_abs;
 use crate::scalar::Scalar;
-
-/// `|x|`.
-fn abs(x: f32) -> f32 {
-    libm::fabsf(x)
-}
 
 /// `(s, e)` with `s = fl(a + b)` and `s + e = a + b` exactly (Knuth's branch-free TwoSum).
 #[inline(always)]
@@ -124,7 +120,8 @@ impl Df {
 
 /// `1 / 2^e` for the binade `2^e <= |x| < 2^(e+1)` of a finite, non-zero `x`, as a power
 /// of two; `2^64` for subnormal `x`. Multiplying by it is exact and brings `x` near 1.
-#[inline(always)]
+#[cfg_attr(not(target_os = "none"), inline(always))]
+#[cfg_attr(target_os = "none", inline(never))]
 pub(crate) fn recip_binade(x: f32) -> f32 {
     let e = (x.to_bits() >> 23) & 0xff; // biased exponent
     if e == 0 {
@@ -161,39 +158,33 @@ pub(crate) fn scale_to_2_60(m: f32) -> (f32, f32) {
 /// the triangle test.
 #[inline(never)]
 pub(crate) fn exact_sum_of_products(x: [f32; 6], y: [f32; 6]) -> f32 {
-    let mut m = 0.0f32;
-    for (&a, &b) in x.iter().zip(&y) {
-        m = m.max_of(abs(a)).max_of(abs(b));
-    }
+    let m = max_abs(&x).max_of(max_abs(&y));
     if m == 0.0 {
         return 0.0;
     }
     let (k1, k2) = scale_to_2_60(m);
     let k = |v: f32| v * k1 * k2;
-    let products: [(f32, f32); 6] = core::array::from_fn(|n| two_prod(k(x[n]), k(y[n])));
-    let terms: [f32; 12] = core::array::from_fn(|n| {
-        let (p, e) = products[(n / 2).min(5)];
-        if n % 2 == 0 {
-            p
-        } else {
-            e
-        }
+    // The twelve terms: each product and its error, in order.
+    let mut terms: [[f32; 2]; 6] = core::array::from_fn(|n| {
+        let (p, e) = two_prod(k(x[n]), k(y[n]));
+        [p, e]
     });
-    exact_sum_sign(terms)
+    exact_sum_sign(terms.as_flattened_mut())
 }
 
 /// The sign of the exact sum of `terms`, as a value: after distillation (repeated error-free
 /// cascades of [`two_sum`], which keep the exact sum, until nothing moves) the last term
 /// carries the sign of the sum and is zero exactly when the sum is zero. The cascade is odd:
-/// negated terms give the negated result.
+/// negated terms give the negated result. `0` for no terms; the terms are left distilled.
 #[inline(always)]
-pub(crate) fn exact_sum_sign<const N: usize>(mut terms: [f32; N]) -> f32 {
+pub(crate) fn exact_sum_sign(terms: &mut [f32]) -> f32 {
+    let n = terms.len();
     // Each pass moves every non-zero remainder up past zeros and merges overlapping terms;
     // a fixed point is a non-overlapping expansion whose largest term is last. The bound only
     // guarantees termination: in practice two or three passes suffice.
-    for _ in 0..4 * N + 8 {
+    for _ in 0..4 * n + 8 {
         let mut moved = false;
-        for i in 1..N {
+        for i in 1..n {
             let (s, e) = two_sum(terms[i], terms[i - 1]);
             moved |= s != terms[i] || e != terms[i - 1];
             terms[i] = s;
@@ -203,7 +194,7 @@ pub(crate) fn exact_sum_sign<const N: usize>(mut terms: [f32; N]) -> f32 {
             break;
         }
     }
-    terms[N - 1]
+    terms.last().copied().unwrap_or(0.0)
 }
 
 #[cfg(test)]
@@ -274,10 +265,10 @@ mod tests {
             // Every third case is an exact zero (c·d = a·b).
             let (q, qe) = if i % 3 == 0 { (p, pe) } else { (q, qe) };
             let exact = (p as f64 + pe as f64) - (q as f64 + qe as f64); // exact: 48-bit terms
-            let got = exact_sum_sign([p, pe, -q, -qe]);
+            let got = exact_sum_sign(&mut [p, pe, -q, -qe]);
             assert_eq!(got > 0.0, exact > 0.0, "{a:e} {b:e} {c:e} {d:e}");
             assert_eq!(got == 0.0, exact == 0.0, "{a:e} {b:e} {c:e} {d:e}");
-            assert_eq!(exact_sum_sign([-p, -pe, q, qe]), -got);
+            assert_eq!(exact_sum_sign(&mut [-p, -pe, q, qe]), -got);
         }
     }
 

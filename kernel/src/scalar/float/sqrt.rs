@@ -2,10 +2,10 @@
 //!
 //! IEEE 754 requires `sqrt` to be correctly rounded, so every implementation gives the same bits.
 //! Hosted targets call `libm::sqrtf`, an instruction on x86_64, aarch64 and wasm32. Bare-metal
-//! targets run the digit-by-digit integer root below instead: `libm`'s portable routine is
-//! larger in flash and carries a lookup table, and no Cortex-M square-root instruction is
-//! reachable from stable Rust without `unsafe`. (The loop is a little slower than that routine
-//! on cores with a fast multiplier; `cargo xtask speed` shows the per-pixel cost.)
+//! ARM cores with a floating-point unit (the `eabihf` targets, e.g. the Cortex-M4F) run their
+//! `vsqrt.f32` instruction, reached through inline assembly (`unsafe`: stable Rust exposes
+//! no square root in `core`). Other bare-metal targets run the digit-by-digit integer root
+//! below: `libm`'s portable routine is larger in flash and carries a lookup table.
 
 /// `√x`, correctly rounded: `-0` for `-0`, `+inf` for `+inf`, NaN for NaN and for `x < 0`.
 #[cfg(not(target_os = "none"))]
@@ -15,7 +15,36 @@ pub(crate) fn sqrtf(x: f32) -> f32 {
 }
 
 /// `√x`, correctly rounded: `-0` for `-0`, `+inf` for `+inf`, NaN for NaN and for `x < 0`.
-#[cfg(target_os = "none")]
+#[cfg(all(target_os = "none", target_arch = "arm", target_abi = "eabihf"))]
+#[allow(unsafe_code)]
+pub(crate) fn sqrtf(x: f32) -> f32 {
+    let mut bits = x.to_bits();
+    // SAFETY: the instructions read and write the general register holding `bits` and the
+    // one named `_`, and `s0`, which they restore before the end; they touch no memory, no
+    // stack and no condition flags. Every `eabihf` target has `vsqrt.f32` (VFPv2 and later),
+    // rounding to nearest as reset leaves the FPSCR. (The registers go through general ones:
+    // the single-precision register class needs a target feature the Cortex-M4F's
+    // single-precision unit does not name.)
+    unsafe {
+        core::arch::asm!(
+            "vmov {saved}, s0",
+            "vmov s0, {bits}",
+            "vsqrt.f32 s0, s0",
+            "vmov {bits}, s0",
+            "vmov s0, {saved}",
+            bits = inout(reg) bits,
+            saved = out(reg) _,
+            options(pure, nomem, nostack, preserves_flags),
+        );
+    }
+    f32::from_bits(bits)
+}
+
+/// `√x`, correctly rounded: `-0` for `-0`, `+inf` for `+inf`, NaN for NaN and for `x < 0`.
+#[cfg(all(
+    target_os = "none",
+    not(all(target_arch = "arm", target_abi = "eabihf"))
+))]
 #[inline(never)]
 pub(crate) fn sqrtf(x: f32) -> f32 {
     integer_sqrt(x)
@@ -29,7 +58,13 @@ pub(crate) fn sqrtf(x: f32) -> f32 {
 /// taken when `r >= 2q + b`. `q` holds the 24-bit significand and one bit more, which alone
 /// decides the rounding: `√y·2^24` is never an odd integer exactly (its square `m·2^25` is
 /// even), so the discarded remainder cannot make a tie.
-#[cfg_attr(not(target_os = "none"), allow(dead_code))]
+#[cfg_attr(
+    any(
+        not(target_os = "none"),
+        all(target_arch = "arm", target_abi = "eabihf")
+    ),
+    allow(dead_code)
+)]
 fn integer_sqrt(x: f32) -> f32 {
     let bits = x.to_bits();
     if x == 0.0 || bits == f32::INFINITY.to_bits() || x.is_nan() {
