@@ -39,7 +39,8 @@ pub(super) fn build<S: Scalar, P: Primitive<S>, B: BuildSettings>(
     for (slot, id) in ids.iter_mut().zip(0u32..) {
         *slot = id;
     }
-    let mut top = TopDown::new(options, n);
+    let mut scratch = Scratch::ZEROED;
+    let mut top = TopDown::new(options, n, &mut scratch);
     load_boxes(
         prims,
         ids,
@@ -119,33 +120,47 @@ struct Work {
 ///
 /// Slices are taken with `get`: the arena checks make every range valid, and the fallbacks,
 /// never taken, only keep panic paths out of the code.
-struct TopDown<S: Scalar, B> {
+struct TopDown<'s, S: Scalar, B> {
     builder: Builder<S, B>,
     n: usize,
     used: usize,
     deepest: u32,
     cached: bool,
+    /// Entries of `scratch.stack` in use.
+    sp: usize,
+    scratch: &'s mut Scratch<S>,
+}
+
+/// The builder's working memory, borrowed so that it is written in place in the caller's
+/// frame ([`Scratch::ZEROED`]): built by a call and returned, its arrays went through a
+/// temporary, twice the stack.
+struct Scratch<S: Scalar> {
     /// Pending nodes: at most one sibling per level plus the current.
     stack: [Pending; MAX_DEPTH + 2],
-    sp: usize,
+    /// SAH bins, emptied by [`TopDown::plant_root`].
     boxes: [[Bin<S>; BINS]; 3],
     counts: [[u32; BINS]; 3],
 }
 
-impl<S: Scalar, B: BuildSettings> TopDown<S, B> {
-    fn new(settings: B, n: usize) -> Self {
-        let pending = Pending {
+impl<S: Scalar> Scratch<S> {
+    /// All zeros: a zeroed bin is not empty, so [`TopDown::plant_root`] empties them.
+    const ZEROED: Self = Self {
+        stack: [Pending {
             index: 0,
             depth: 0,
             centroids: ([0.0; 3], [0.0; 3]),
-        };
-        // Zeroed (in place), then emptied bin by bin: an array of `Bin::empty()` was built in
-        // a temporary and copied, 3.5 KB more stack on the M0.
-        let zero = Bin {
+        }; MAX_DEPTH + 2],
+        boxes: [[Bin {
             lo: [S::ZERO; 4],
             hi: [S::ZERO; 4],
-        };
-        let mut top = Self {
+        }; BINS]; 3],
+        counts: [[0; BINS]; 3],
+    };
+}
+
+impl<'s, S: Scalar, B: BuildSettings> TopDown<'s, S, B> {
+    fn new(settings: B, n: usize, scratch: &'s mut Scratch<S>) -> Self {
+        Self {
             builder: Builder {
                 max_leaf: settings.max_leaf_size() as usize,
                 settings,
@@ -155,15 +170,9 @@ impl<S: Scalar, B: BuildSettings> TopDown<S, B> {
             used: 0,
             deepest: 0,
             cached: n >= 2,
-            stack: [pending; MAX_DEPTH + 2],
             sp: 0,
-            boxes: [[zero; BINS]; 3],
-            counts: [[0; BINS]; 3],
-        };
-        for bin in top.boxes.iter_mut().flatten() {
-            *bin = Bin::empty();
+            scratch,
         }
-        top
     }
 
     /// The arena slots to fill with every primitive's box, in id order ([`load_boxes`]),
@@ -182,13 +191,16 @@ impl<S: Scalar, B: BuildSettings> TopDown<S, B> {
         if n < 2 {
             return; // a single primitive: the loaded slot is the root
         }
+        for bin in self.scratch.boxes.iter_mut().flatten() {
+            *bin = Bin::empty();
+        }
         let root = summarize(nodes.get(n..2 * n).unwrap_or_default());
         if let [root_slot, pad, ..] = nodes {
             *root_slot = Node::leaf(root.bounds(), 0, n as u32);
             *pad = Node::EMPTY;
         }
         self.used = FIRST_PAIR;
-        if let Some(slot) = self.stack.first_mut() {
+        if let Some(slot) = self.scratch.stack.first_mut() {
             *slot = Pending {
                 index: 0,
                 depth: 0,
@@ -202,7 +214,7 @@ impl<S: Scalar, B: BuildSettings> TopDown<S, B> {
     fn next(&mut self, nodes: &mut [Node<S>], ids: &mut [u32]) -> Option<Work> {
         let n = self.n;
         self.sp = self.sp.checked_sub(1)?;
-        let pending = *self.stack.get(self.sp)?;
+        let pending = *self.scratch.stack.get(self.sp)?;
         let node = nodes.get(pending.index as usize)?;
         let (first, count) = (node.first as usize, node.count as usize);
         self.deepest = self.deepest.max(pending.depth);
@@ -246,8 +258,8 @@ impl<S: Scalar, B: BuildSettings> TopDown<S, B> {
             return;
         };
         let mut bins = Bins {
-            boxes: &mut self.boxes,
-            counts: &mut self.counts,
+            boxes: &mut self.scratch.boxes,
+            counts: &mut self.scratch.counts,
         };
         let split = self
             .builder
@@ -280,7 +292,7 @@ impl<S: Scalar, B: BuildSettings> TopDown<S, B> {
         }
         // Right pushed first so the left subtree is built (and laid out) first.
         for (child, side) in [(l + 1, right), (l, left)] {
-            if let Some(slot) = self.stack.get_mut(self.sp) {
+            if let Some(slot) = self.scratch.stack.get_mut(self.sp) {
                 *slot = Pending {
                     index: child as u32,
                     depth: depth + 1,
