@@ -465,17 +465,16 @@ fn summarize<S: Scalar>(slots: &[Node<S>]) -> Side<S> {
     side
 }
 
-/// Partitions `slots` by `left`, summarizing both sides on the way.
-fn partition_by<S: Scalar>(
-    slots: &mut [Node<S>],
-    left: impl Fn(&Node<S>, &Aabb<S>) -> bool,
-) -> [Side<S>; 2] {
+/// Partitions `slots` into those whose tag's field `(tag >> shift) & 31` (an SAH bin, or 0/1
+/// as [`tag_halves`] sets) is at most `last` and the rest, summarizing both sides on the way.
+/// One loop for every split rule, so a firmware links it once.
+fn partition_by<S: Scalar>(slots: &mut [Node<S>], shift: u32, last: u32) -> [Side<S>; 2] {
     let mut sides = [Side::empty(), Side::empty()];
     let (mut i, mut j) = (0, slots.len());
     while i < j {
         let Some(slot) = slots.get(i) else { break };
         let b = slot.bounds();
-        if left(slot, &b) {
+        if (slot.count >> shift) & 31 <= last {
             sides[0].add(&b);
             i += 1;
         } else {
@@ -485,6 +484,16 @@ fn partition_by<S: Scalar>(
         }
     }
     sides
+}
+
+/// Tags each slot 0 if its [`key`] on `axis` is below `bound` (`inclusive`: at most `bound`),
+/// else 1, for [`partition_by`] with `shift` 0 and `last` 0.
+fn tag_halves<S: Scalar>(slots: &mut [Node<S>], axis: usize, bound: f32, inclusive: bool) {
+    for slot in slots.iter_mut() {
+        let k = key(&slot.bounds(), axis);
+        let left = k < bound || (inclusive && k == bound);
+        slot.count = u32::from(!left);
+    }
 }
 
 impl<S: Scalar, B: BuildSettings> Builder<S, B> {
@@ -517,7 +526,8 @@ impl<S: Scalar, B: BuildSettings> Builder<S, B> {
             BuilderKind::Median => must_split.then(|| median(slots, widest)),
             BuilderKind::Midpoint => must_split.then(|| {
                 let mid = clo[widest] * 0.5 + chi[widest] * 0.5;
-                let sides = partition_by(slots, |_, b| key(b, widest) < mid);
+                tag_halves(slots, widest, mid, false);
+                let sides = partition_by(slots, 0, 0);
                 if sides[0].count == 0 || sides[1].count == 0 {
                     median(slots, widest)
                 } else {
@@ -554,7 +564,8 @@ impl<S: Scalar, B: BuildSettings> Builder<S, B> {
         if let [p, q] = slots {
             let pair = [p.bounds(), q.bounds()];
             let axis = self.sah_pair(pair, &scale)?.min(2); // `min`: shows the bound
-            return Some(partition_by(slots, |_, b| key(b, axis) <= clo[axis]));
+            tag_halves(slots, axis, clo[axis], true);
+            return Some(partition_by(slots, 0, 0));
         }
         // Bin each primitive on all three axes, remembering its bins in the slot's tag for the
         // partition below.
@@ -583,11 +594,8 @@ impl<S: Scalar, B: BuildSettings> Builder<S, B> {
         {
             return None;
         }
-        let axis = axis.min(2); // a no-op that shows the compiler the bound
-        let shift = 5 * axis;
-        Some(partition_by(slots, |slot, _| {
-            (slot.count >> shift) as usize & 31 <= last_left_bin
-        }))
+        let shift = 5 * axis.min(2) as u32; // `min`: a no-op that shows the bound
+        Some(partition_by(slots, shift, last_left_bin as u32))
     }
 
     /// [`Builder::sah`] for two primitives with boxes `p`, `q`: the axis to split on, or `None`
