@@ -417,6 +417,18 @@ impl<S: Scalar> Side<S> {
         self.centroid_hi = self.centroid_hi.max(c);
     }
 
+    /// A copy built field by field: returned whole, a side is copied out with a `memcpy`
+    /// call on thumb targets, which links `memcpy`.
+    #[inline(always)]
+    fn copied(&self) -> Self {
+        Self {
+            count: self.count,
+            bin: self.bin,
+            centroid_lo: self.centroid_lo,
+            centroid_hi: self.centroid_hi,
+        }
+    }
+
     fn bounds(&self) -> Aabb<S> {
         let (lo, hi) = (&self.bin.lo, &self.bin.hi);
         Aabb::new([lo[0], lo[1], lo[2]], [hi[0], hi[1], hi[2]])
@@ -462,7 +474,7 @@ fn summarize<S: Scalar>(slots: &[Node<S>]) -> Side<S> {
     for slot in slots {
         side.add(&slot.bounds());
     }
-    side
+    side.copied()
 }
 
 /// Partitions `slots` into those whose tag's field `(tag >> shift) & 31` (an SAH bin, or 0/1
@@ -483,7 +495,7 @@ fn partition_by<S: Scalar>(slots: &mut [Node<S>], shift: u32, last: u32) -> [Sid
             swap_in(slots, i, j);
         }
     }
-    sides
+    [sides[0].copied(), sides[1].copied()]
 }
 
 /// Tags each slot 0 if its [`key`] on `axis` is below `bound` (`inclusive`: at most `bound`),
