@@ -145,11 +145,7 @@ struct Scratch<S: Scalar> {
 impl<S: Scalar> Scratch<S> {
     /// All zeros: a zeroed bin is not empty, so [`TopDown::plant_root`] empties them.
     const ZEROED: Self = Self {
-        stack: [Pending {
-            index: 0,
-            depth: 0,
-            centroids: ([0.0; 3], [0.0; 3]),
-        }; MAX_DEPTH + 2],
+        stack: [Pending { index: 0, depth: 0 }; MAX_DEPTH + 2],
         boxes: [[Bin {
             lo: [S::ZERO; 4],
             hi: [S::ZERO; 4],
@@ -201,11 +197,7 @@ impl<'s, S: Scalar, B: BuildSettings> TopDown<'s, S, B> {
         }
         self.used = FIRST_PAIR;
         if let Some(slot) = self.scratch.stack.first_mut() {
-            *slot = Pending {
-                index: 0,
-                depth: 0,
-                centroids: root.centroids(),
-            };
+            *slot = Pending { index: 0, depth: 0 };
             self.sp = 1;
         }
     }
@@ -246,12 +238,7 @@ impl<'s, S: Scalar, B: BuildSettings> TopDown<'s, S, B> {
         let Work {
             prims,
             slots,
-            pending:
-                Pending {
-                    index,
-                    depth,
-                    centroids,
-                },
+            pending: Pending { index, depth },
             ..
         } = work;
         let Some(slots) = nodes.get_mut(slots) else {
@@ -261,9 +248,7 @@ impl<'s, S: Scalar, B: BuildSettings> TopDown<'s, S, B> {
             boxes: &mut self.scratch.boxes,
             counts: &mut self.scratch.counts,
         };
-        let split = self
-            .builder
-            .split(slots, depth as usize, &centroids, &mut bins);
+        let split = self.builder.split(slots, depth as usize, &mut bins);
         // Cache slots stay partitioned in place until the node is a leaf; loaded slots are
         // overwritten by the next nodes.
         if split.is_none() || !self.cached {
@@ -291,12 +276,11 @@ impl<'s, S: Scalar, B: BuildSettings> TopDown<'s, S, B> {
             parent.count = 0;
         }
         // Right pushed first so the left subtree is built (and laid out) first.
-        for (child, side) in [(l + 1, right), (l, left)] {
+        for child in [l + 1, l] {
             if let Some(slot) = self.scratch.stack.get_mut(self.sp) {
                 *slot = Pending {
                     index: child as u32,
                     depth: depth + 1,
-                    centroids: side.centroids(),
                 };
                 self.sp += 1;
             }
@@ -375,25 +359,21 @@ fn centroid<S: Scalar>(lo: &[S; 4], hi: &[S; 4]) -> F4 {
     lo.mul(half).add(hi.mul(half))
 }
 
-/// A node waiting to be split.
+/// A node waiting to be split: 8 bytes, as the stack holds one per level. Its centroid
+/// bounds are not kept (24 bytes more per entry) but found again when it is split
+/// ([`centroid_bounds`]), in a pass that reads the boxes the split reads next.
 #[derive(Clone, Copy)]
 struct Pending {
     index: u32,
     depth: u32,
-    centroids: Centroids,
 }
 
-/// Per-axis (min, max) of the centroid keys of a set of primitives.
-type Centroids = ([f32; 3], [f32; 3]);
-
-/// What a split search knows about one side: its size, box and centroid bounds (as four
-/// lanes, lane 3 repeating lane 2).
+/// What a split search knows about one side: its size and box (as four lanes, lane 3
+/// repeating lane 2).
 #[derive(Clone, Copy)]
 struct Side<S: Scalar> {
     count: usize,
     bin: Bin<S>,
-    centroid_lo: F4,
-    centroid_hi: F4,
 }
 
 impl<S: Scalar> Side<S> {
@@ -401,20 +381,14 @@ impl<S: Scalar> Side<S> {
         Self {
             count: 0,
             bin: Bin::empty(),
-            centroid_lo: F4::splat(f32::INFINITY),
-            centroid_hi: F4::splat(f32::NEG_INFINITY),
         }
     }
 
-    /// Adds a box: a union, and the min/max of its [`key`]s, in lanes.
+    /// Adds a box.
     #[inline(always)]
     fn add(&mut self, b: &Aabb<S>) {
         self.count += 1;
-        let (lo, hi) = (lanes(&b.lo), lanes(&b.hi));
-        self.bin.grow(&lo, &hi);
-        let c = centroid(&lo, &hi);
-        self.centroid_lo = self.centroid_lo.min(c);
-        self.centroid_hi = self.centroid_hi.max(c);
+        self.bin.grow(&lanes(&b.lo), &lanes(&b.hi));
     }
 
     /// A copy built field by field: returned whole, a side is copied out with a `memcpy`
@@ -424,8 +398,6 @@ impl<S: Scalar> Side<S> {
         Self {
             count: self.count,
             bin: self.bin,
-            centroid_lo: self.centroid_lo,
-            centroid_hi: self.centroid_hi,
         }
     }
 
@@ -433,11 +405,18 @@ impl<S: Scalar> Side<S> {
         let (lo, hi) = (&self.bin.lo, &self.bin.hi);
         Aabb::new([lo[0], lo[1], lo[2]], [hi[0], hi[1], hi[2]])
     }
+}
 
-    fn centroids(&self) -> Centroids {
-        let (lo, hi) = (self.centroid_lo.to_array(), self.centroid_hi.to_array());
-        ([lo[0], lo[1], lo[2]], [hi[0], hi[1], hi[2]])
+/// Per-axis (min, max) of the [`key`]s of the boxes in `slots`.
+fn centroid_bounds<S: Scalar>(slots: &[Node<S>]) -> ([f32; 3], [f32; 3]) {
+    let (mut lo, mut hi) = (F4::splat(f32::INFINITY), F4::splat(f32::NEG_INFINITY));
+    for slot in slots {
+        let c = centroid(&lanes(&slot.lo), &lanes(&slot.hi));
+        lo = lo.min(c);
+        hi = hi.max(c);
     }
+    let (lo, hi) = (lo.to_array(), hi.to_array());
+    ([lo[0], lo[1], lo[2]], [hi[0], hi[1], hi[2]])
 }
 
 /// The split rules, over arena slots each holding one primitive's box and id (`first`), with
@@ -468,7 +447,7 @@ fn lowest<S: Scalar>() -> S {
     S::from_f32_saturating(f32::NEG_INFINITY)
 }
 
-/// Count, box and centroid bounds of the boxes in `slots`.
+/// Count and box of the boxes in `slots`.
 fn summarize<S: Scalar>(slots: &[Node<S>]) -> Side<S> {
     let mut side = Side::empty();
     for slot in slots {
@@ -514,14 +493,13 @@ impl<S: Scalar, B: BuildSettings> Builder<S, B> {
         &self,
         slots: &mut [Node<S>],
         depth: usize,
-        centroids: &Centroids,
         bins: &mut Bins<'_, S>,
     ) -> Option<[Side<S>; 2]> {
         let count = slots.len();
         if count <= 1 {
             return None;
         }
-        let (clo, chi) = centroids;
+        let (clo, chi) = &centroid_bounds(slots);
         let extent: [f32; 3] = core::array::from_fn(|i| chi[i] - clo[i]);
         let widest = if extent[0] >= extent[1] && extent[0] >= extent[2] {
             0
