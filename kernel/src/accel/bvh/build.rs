@@ -132,7 +132,7 @@ struct TopDown<'s, S: Scalar, B> {
 }
 
 /// The builder's working memory, borrowed so that it is written in place in the caller's
-/// frame ([`Scratch::ZEROED`]): built by a call and returned, its arrays went through a
+/// frame ([`Scratch::ZEROED`]): built by a call and returned, its arrays would go through a
 /// temporary, twice the stack.
 struct Scratch<S: Scalar> {
     /// Pending nodes: at most one sibling per level plus the current.
@@ -359,9 +359,9 @@ fn centroid<S: Scalar>(lo: &[S; 4], hi: &[S; 4]) -> F4 {
     lo.mul(half).add(hi.mul(half))
 }
 
-/// A node waiting to be split: 8 bytes, as the stack holds one per level. Its centroid
-/// bounds are not kept (24 bytes more per entry) but found again when it is split
-/// ([`centroid_bounds`]), in a pass that reads the boxes the split reads next.
+/// A node waiting to be split. Its centroid bounds are not kept, which would make the
+/// stack (one entry per level) four times larger, but found again when it is split
+/// ([`centroid_bounds`]), in a pass over the boxes the split reads next.
 #[derive(Clone, Copy)]
 struct Pending {
     index: u32,

@@ -3,7 +3,7 @@
 /// Swaps `v[a]` and `v[b]`; a no-op if either index is out of range or they are equal.
 /// Callers pass proven indices: the checks only let the compiler drop a panic path. Through
 /// two disjoint borrows rather than `slice::swap`, which may see one slot twice and so
-/// calls `memmove` (1.5 KB on thumb targets) for 32-byte slots.
+/// calls `memmove` on thumb targets for 32-byte slots.
 #[inline(always)]
 pub(super) fn swap_in<T>(v: &mut [T], a: usize, b: usize) {
     let (lo, hi) = if a < b { (a, b) } else { (b, a) };
