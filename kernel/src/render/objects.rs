@@ -30,7 +30,7 @@ impl<S: Scalar, F: AccelFamily<S>> core::fmt::Debug for ShapeAccel<'_, S, F> {
 
 impl<'a, S: Scalar, F: AccelFamily<S>> ShapeAccel<'a, S, F> {
     /// Builds `shape`'s accelerator into `memory`. Never inlined: the builders' working memory
-    /// (BVH bins and pending nodes, about 6 KB) then sits on the stack once, not once per
+    /// (BVH bins and pending nodes) then sits on the stack once, not once per
     /// primitive type.
     #[inline(never)]
     pub(super) fn build(

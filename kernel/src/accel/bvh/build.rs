@@ -1,6 +1,10 @@
 //! Top-down builders writing into the caller's arena. Iterative: an explicit stack of pending
 //! nodes replaces recursion. Split decisions use `f32` keys (centroids, areas) in both modes;
 //! `f32` arithmetic is deterministic, so fixed-point trees are identical on every platform too.
+//!
+//! Only [`load_boxes`] and the input checks see the primitives: every split reads their boxes
+//! from arena slots, so the split code is compiled once per number mode and build settings,
+//! not once per primitive type.
 
 use super::select::{select_nth, swap_in};
 use super::{
@@ -11,6 +15,7 @@ use crate::accel::{check_count, check_each, Arena, BuildError};
 use crate::geom::{Aabb, Primitive};
 use crate::scalar::lanes::F4;
 use crate::scalar::Scalar;
+use core::ops::Range;
 
 /// Bins per axis for the SAH builder.
 const BINS: usize = 32;
@@ -25,169 +30,239 @@ pub(super) fn build<S: Scalar, P: Primitive<S>, B: BuildSettings>(
     ids: &mut [u32],
     options: B,
 ) -> Result<(usize, u32), BuildError> {
-    let (used, mut deepest) = split_top_down(prims, nodes, ids, options)?;
-    if options.reinsertion() {
-        let arena = nodes.get_mut(..nodes_needed(prims.len()));
-        if let (Some(arena), Some(ids)) = (arena, ids.get_mut(..prims.len())) {
-            if let Some(depth) = super::optimize::reinsert(arena, used, ids) {
-                deepest = depth;
-            }
-        }
-    }
-    for node in nodes.iter_mut().take(used) {
-        let (lo, hi) = S::pad_bounds(node.lo, node.hi);
-        node.lo = lo;
-        node.hi = hi;
-    }
-    Ok((used, deepest))
-}
-
-/// The top-down build into `nodes`/`ids`, bounds unpadded.
-fn split_top_down<S: Scalar, P: Primitive<S>, B: BuildSettings>(
-    prims: &[P],
-    nodes: &mut [Node<S>],
-    ids: &mut [u32],
-    options: B,
-) -> Result<(usize, u32), BuildError> {
     let n = prims.len();
-    check_count(n)?;
-    let max_leaf_size = options.max_leaf_size();
-    if max_leaf_size == 0 || max_leaf_size > MAX_LEAF_SIZE {
-        return Err(BuildError::BadLeafSize { max_leaf_size });
-    }
-    let needed = nodes_needed(n);
-    if nodes.len() < needed {
-        return Err(BuildError::ArenaTooSmall {
-            arena: Arena::Nodes,
-            needed,
-            available: nodes.len(),
-        });
-    }
-    if ids.len() < n {
-        return Err(BuildError::ArenaTooSmall {
-            arena: Arena::PrimIds,
-            needed: n,
-            available: ids.len(),
-        });
-    }
+    check_arena(n, nodes.len(), ids.len(), options.max_leaf_size())?;
     check_each(prims)?;
-    if n == 0 {
-        return Ok((0, 0));
-    }
-    let Some(ids) = ids.get_mut(..n) else {
-        return Err(BuildError::ArenaTooSmall {
-            arena: Arena::PrimIds,
-            needed: n,
-            available: ids.len(),
-        });
+    let (Some(ids), Some(arena)) = (ids.get_mut(..n), nodes.get_mut(..nodes_needed(n))) else {
+        return Ok((0, 0)); // unreachable: `check_arena` checked both sizes
     };
     for (slot, id) in ids.iter_mut().zip(0u32..) {
         *slot = id;
     }
-    let builder = Builder {
+    let mut scratch = Scratch::ZEROED;
+    let mut top = TopDown::new(options, n, &mut scratch);
+    load_boxes(
         prims,
-        max_leaf: max_leaf_size as usize,
-        settings: options,
-        _scalar: core::marker::PhantomData,
-    };
-    // Bounds cache: while it is valid, slot `n + pos` of the arena holds the bounds and id of
-    // the primitive at position `pos` (a one-primitive leaf), and the builder partitions these
-    // slots instead of ids: sequential reads instead of recomputing scattered primitives.
-    // Nodes are allocated left to right and every position left of the current node is
-    // final, so the cache stays intact while `used + 2 <= n + first`; when a split would break
-    // that, the ids are written back and the build goes on from the primitives themselves.
-    // (Slices below are taken with `get`: the arena checks above make every range valid, and
-    // the fallbacks, never taken, only keep panic paths out of the code.)
-    let mut cached = false;
-    if let (true, Some(cache)) = (n >= 2, nodes.get_mut(n..2 * n)) {
-        for (pos, slot) in cache.iter_mut().enumerate() {
-            let bounds = builder.prim(pos as u32);
-            *slot = Node::leaf(bounds, pos as u32, 1);
+        ids,
+        arena.get_mut(top.first_load()).unwrap_or_default(),
+    );
+    top.plant_root(arena);
+    while let Some(work) = top.next(arena, ids) {
+        if work.load {
+            let work_ids = ids.get(work.prims.clone()).unwrap_or_default();
+            let slots = arena.get_mut(work.slots.clone()).unwrap_or_default();
+            load_boxes(prims, work_ids, slots);
         }
-        cached = true;
+        top.split(work, arena, ids);
     }
-    let root = match (cached, nodes.get(n..2 * n)) {
-        (true, Some(cache)) => builder.summarize(cache),
-        _ => builder.summarize(ids),
+    Ok(top.finish(arena, ids))
+}
+
+/// Writes, for each id in `ids`, the box of `prims[id]` and the id into a slot of `slots` (a
+/// one-primitive leaf), in order.
+fn load_boxes<S: Scalar, P: Primitive<S>>(prims: &[P], ids: &[u32], slots: &mut [Node<S>]) {
+    for (slot, &id) in slots.iter_mut().zip(ids) {
+        let bounds = match prims.get(id as usize) {
+            Some(p) => p.bounds(),
+            None => empty_box(),
+        };
+        *slot = Node::leaf(bounds, id, 1);
+    }
+}
+
+/// The size checks of a build over `n` primitives with arenas of `nodes` and `ids` slots.
+fn check_arena(n: usize, nodes: usize, ids: usize, max_leaf_size: u32) -> Result<(), BuildError> {
+    check_count(n)?;
+    if max_leaf_size == 0 || max_leaf_size > MAX_LEAF_SIZE {
+        return Err(BuildError::BadLeafSize { max_leaf_size });
+    }
+    let needed = nodes_needed(n);
+    if nodes < needed {
+        return Err(BuildError::ArenaTooSmall {
+            arena: Arena::Nodes,
+            needed,
+            available: nodes,
+        });
+    }
+    if ids < n {
+        return Err(BuildError::ArenaTooSmall {
+            arena: Arena::PrimIds,
+            needed: n,
+            available: ids,
+        });
+    }
+    Ok(())
+}
+
+/// A node to split, as [`TopDown::next`] hands it out.
+struct Work {
+    /// The node's primitives, as positions in `ids`.
+    prims: Range<usize>,
+    /// Where its primitives' boxes are: arena slots, one per position.
+    slots: Range<usize>,
+    /// True if the caller must first fill `slots` with [`load_boxes`].
+    load: bool,
+    pending: Pending,
+}
+
+/// The state of a top-down build over `n` primitives between two splits.
+///
+/// Bounds cache: while `cached`, slot `n + pos` of the arena holds the box and id of the
+/// primitive at position `pos` (a one-primitive leaf), and splits partition these slots
+/// instead of ids: sequential reads instead of scattered primitives. Nodes are allocated left
+/// to right and every position left of the current node is final, so the cache stays intact
+/// while `used + 2 <= n + first`. When a split would break that, the ids of the positions left
+/// are written back, and from then on each node's boxes are loaded into the free slots from
+/// `used` on before it is split. They fit: with `L` finished leaves (all left of `first`) and
+/// `p` pending nodes (the current one, of `c >= 2` primitives, included), `used = 2L + 2p`
+/// and the pending nodes share the `n - first >= c + p - 1` positions left, so
+/// `2n - used >= 2(n - first) - 2p >= 2c - 2 >= c`.
+///
+/// Slices are taken with `get`: the arena checks make every range valid, and the fallbacks,
+/// never taken, only keep panic paths out of the code.
+struct TopDown<'s, S: Scalar, B> {
+    builder: Builder<S, B>,
+    n: usize,
+    used: usize,
+    deepest: u32,
+    cached: bool,
+    /// Entries of `scratch.stack` in use.
+    sp: usize,
+    scratch: &'s mut Scratch<S>,
+}
+
+/// The builder's working memory, borrowed so that it is written in place in the caller's
+/// frame ([`Scratch::ZEROED`]): built by a call and returned, its arrays would go through a
+/// temporary, twice the stack.
+struct Scratch<S: Scalar> {
+    /// Pending nodes: at most one sibling per level plus the current.
+    stack: [Pending; MAX_DEPTH + 2],
+    /// SAH bins, emptied by [`TopDown::plant_root`].
+    boxes: [[Bin<S>; BINS]; 3],
+    counts: [[u32; BINS]; 3],
+}
+
+impl<S: Scalar> Scratch<S> {
+    /// All zeros: a zeroed bin is not empty, so [`TopDown::plant_root`] empties them.
+    const ZEROED: Self = Self {
+        stack: [Pending { index: 0, depth: 0 }; MAX_DEPTH + 2],
+        boxes: [[Bin {
+            lo: [S::ZERO; 4],
+            hi: [S::ZERO; 4],
+        }; BINS]; 3],
+        counts: [[0; BINS]; 3],
     };
-    let mut used = 1usize;
-    match nodes {
-        [root_slot, pad, ..] if n > 1 => {
+}
+
+impl<'s, S: Scalar, B: BuildSettings> TopDown<'s, S, B> {
+    fn new(settings: B, n: usize, scratch: &'s mut Scratch<S>) -> Self {
+        Self {
+            builder: Builder {
+                max_leaf: settings.max_leaf_size() as usize,
+                settings,
+                _scalar: core::marker::PhantomData,
+            },
+            n,
+            used: 0,
+            deepest: 0,
+            cached: n >= 2,
+            sp: 0,
+            scratch,
+        }
+    }
+
+    /// The arena slots to fill with every primitive's box, in id order ([`load_boxes`]),
+    /// before [`TopDown::plant_root`]: the bounds cache, or for a single primitive the root.
+    fn first_load(&self) -> Range<usize> {
+        match self.n {
+            0 | 1 => 0..self.n,
+            n => n..2 * n,
+        }
+    }
+
+    /// Makes the root, a leaf holding every primitive, and queues it to be split.
+    fn plant_root(&mut self, nodes: &mut [Node<S>]) {
+        let n = self.n;
+        self.used = n.min(1);
+        if n < 2 {
+            return; // a single primitive: the loaded slot is the root
+        }
+        for bin in self.scratch.boxes.iter_mut().flatten() {
+            *bin = Bin::empty();
+        }
+        let root = summarize(nodes.get(n..2 * n).unwrap_or_default());
+        if let [root_slot, pad, ..] = nodes {
             *root_slot = Node::leaf(root.bounds(), 0, n as u32);
             *pad = Node::EMPTY;
-            used = FIRST_PAIR;
         }
-        [root_slot, ..] => *root_slot = Node::leaf(root.bounds(), 0, n as u32),
-        [] => return Ok((0, 0)),
+        self.used = FIRST_PAIR;
+        if let Some(slot) = self.scratch.stack.first_mut() {
+            *slot = Pending { index: 0, depth: 0 };
+            self.sp = 1;
+        }
     }
-    let mut deepest = 0u32;
-    // Pending nodes with their centroid bounds: at most one sibling per level plus the current.
-    let mut stack = [Pending {
-        index: 0,
-        depth: 0,
-        centroids: root.centroids(),
-    }; MAX_DEPTH + 2];
-    let mut sp = 1usize;
-    // Zeroed (in place), then emptied bin by bin: an array of `Bin::empty()` was built in a
-    // temporary and copied, 3.5 KB more stack on the M0.
-    let zero = Bin {
-        lo: [S::ZERO; 4],
-        hi: [S::ZERO; 4],
-    };
-    let mut boxes = [[zero; BINS]; 3];
-    for bin in boxes.iter_mut().flatten() {
-        *bin = Bin::empty();
-    }
-    let mut counts = [[0u32; BINS]; 3];
-    let mut bins = Bins {
-        boxes: &mut boxes,
-        counts: &mut counts,
-    };
-    while sp > 0 {
-        sp -= 1;
-        let Some(&Pending {
-            index,
-            depth,
-            centroids,
-        }) = stack.get(sp)
-        else {
-            break;
-        };
-        let Some(&node) = nodes.get(index as usize) else {
-            continue;
-        };
+
+    /// The next node to split (the root first), `None` when the build is done.
+    fn next(&mut self, nodes: &mut [Node<S>], ids: &mut [u32]) -> Option<Work> {
+        let n = self.n;
+        self.sp = self.sp.checked_sub(1)?;
+        let pending = *self.scratch.stack.get(self.sp)?;
+        let node = nodes.get(pending.index as usize)?;
         let (first, count) = (node.first as usize, node.count as usize);
-        deepest = deepest.max(depth);
-        if cached && used + 2 > n + first {
+        self.deepest = self.deepest.max(pending.depth);
+        if self.cached && self.used + 2 > n + first {
             let cache = nodes.get(n + first..2 * n).unwrap_or_default();
             for (id, slot) in ids.iter_mut().skip(first).zip(cache) {
                 *id = slot.first;
             }
-            cached = false;
+            self.cached = false;
         }
-        let range = first..first + count;
-        let split = match (cached, nodes.get_mut(n + first..n + first + count)) {
-            (true, Some(slots)) => {
-                let split = builder.split(slots, depth as usize, &centroids, &mut bins);
-                if split.is_none() {
-                    let leaf_ids = ids.get_mut(range).unwrap_or_default();
-                    for (id, slot) in leaf_ids.iter_mut().zip(slots.iter()) {
-                        *id = slot.first;
-                    }
-                }
-                split
+        let prims = first..first + count;
+        let (slots, load) = if self.cached {
+            (n + first..n + first + count, false)
+        } else if count >= 2 {
+            (self.used..self.used + count, true)
+        } else {
+            (0..0, false) // a leaf, its id already written back
+        };
+        Some(Work {
+            prims,
+            slots,
+            load,
+            pending,
+        })
+    }
+
+    /// Splits the node `work` names (its boxes in place), or makes it a leaf.
+    fn split(&mut self, work: Work, nodes: &mut [Node<S>], ids: &mut [u32]) {
+        let Work {
+            prims,
+            slots,
+            pending: Pending { index, depth },
+            ..
+        } = work;
+        let Some(slots) = nodes.get_mut(slots) else {
+            return;
+        };
+        let mut bins = Bins {
+            boxes: &mut self.scratch.boxes,
+            counts: &mut self.scratch.counts,
+        };
+        let split = self.builder.split(slots, depth as usize, &mut bins);
+        // Cache slots stay partitioned in place until the node is a leaf; loaded slots are
+        // overwritten by the next nodes.
+        if split.is_none() || !self.cached {
+            let node_ids = ids.get_mut(prims.clone()).unwrap_or_default();
+            for (id, slot) in node_ids.iter_mut().zip(slots.iter()) {
+                *id = slot.first;
             }
-            _ => match ids.get_mut(range) {
-                Some(leaf_ids) => builder.split(leaf_ids, depth as usize, &centroids, &mut bins),
-                None => None,
-            },
-        };
+        }
         let Some([left, right]) = split else {
-            continue;
+            return;
         };
-        let l = used;
+        let (first, l) = (prims.start, self.used);
         let Some([a, b]) = nodes.get_mut(l..l + 2) else {
-            continue;
+            return;
         };
         *a = Node::leaf(left.bounds(), first as u32, left.count as u32);
         *b = Node::leaf(
@@ -195,27 +270,39 @@ fn split_top_down<S: Scalar, P: Primitive<S>, B: BuildSettings>(
             (first + left.count) as u32,
             right.count as u32,
         );
-        used += 2;
+        self.used += 2;
         if let Some(parent) = nodes.get_mut(index as usize) {
-            *parent = Node {
-                first: l as u32,
-                count: 0,
-                ..node
-            };
+            parent.first = l as u32;
+            parent.count = 0;
         }
         // Right pushed first so the left subtree is built (and laid out) first.
-        for (child, side) in [(l + 1, right), (l, left)] {
-            if let Some(slot) = stack.get_mut(sp) {
+        for child in [l + 1, l] {
+            if let Some(slot) = self.scratch.stack.get_mut(self.sp) {
                 *slot = Pending {
                     index: child as u32,
                     depth: depth + 1,
-                    centroids: side.centroids(),
                 };
-                sp += 1;
+                self.sp += 1;
             }
         }
     }
-    Ok((used, deepest))
+
+    /// Ends the build: the optional reinsertion pass, then bounds padded for traversal.
+    /// Returns (nodes used, depth of the deepest leaf).
+    fn finish(&self, nodes: &mut [Node<S>], ids: &mut [u32]) -> (usize, u32) {
+        let (used, mut deepest) = (self.used, self.deepest);
+        if self.builder.settings.reinsertion() {
+            if let Some(depth) = super::optimize::reinsert(nodes, used, ids) {
+                deepest = depth;
+            }
+        }
+        for node in nodes.iter_mut().take(used) {
+            let (lo, hi) = S::pad_bounds(node.lo, node.hi);
+            node.lo = lo;
+            node.hi = hi;
+        }
+        (used, deepest)
+    }
 }
 
 /// One SAH bin's box, as four lanes per corner (lane 3 repeats lane 2) so that a union is
@@ -272,25 +359,21 @@ fn centroid<S: Scalar>(lo: &[S; 4], hi: &[S; 4]) -> F4 {
     lo.mul(half).add(hi.mul(half))
 }
 
-/// A node waiting to be split.
+/// A node waiting to be split. Its centroid bounds are not kept, which would make the
+/// stack (one entry per level) four times larger, but found again when it is split
+/// ([`centroid_bounds`]), in a pass over the boxes the split reads next.
 #[derive(Clone, Copy)]
 struct Pending {
     index: u32,
     depth: u32,
-    centroids: Centroids,
 }
 
-/// Per-axis (min, max) of the centroid keys of a set of primitives.
-type Centroids = ([f32; 3], [f32; 3]);
-
-/// What a split search knows about one side: its size, box and centroid bounds (as four
-/// lanes, lane 3 repeating lane 2).
+/// What a split search knows about one side: its size and box (as four lanes, lane 3
+/// repeating lane 2).
 #[derive(Clone, Copy)]
 struct Side<S: Scalar> {
     count: usize,
     bin: Bin<S>,
-    centroid_lo: F4,
-    centroid_hi: F4,
 }
 
 impl<S: Scalar> Side<S> {
@@ -298,35 +381,47 @@ impl<S: Scalar> Side<S> {
         Self {
             count: 0,
             bin: Bin::empty(),
-            centroid_lo: F4::splat(f32::INFINITY),
-            centroid_hi: F4::splat(f32::NEG_INFINITY),
         }
     }
 
-    /// Adds a box: a union, and the min/max of its [`key`]s, in lanes.
+    /// Adds a box.
     #[inline(always)]
     fn add(&mut self, b: &Aabb<S>) {
         self.count += 1;
-        let (lo, hi) = (lanes(&b.lo), lanes(&b.hi));
-        self.bin.grow(&lo, &hi);
-        let c = centroid(&lo, &hi);
-        self.centroid_lo = self.centroid_lo.min(c);
-        self.centroid_hi = self.centroid_hi.max(c);
+        self.bin.grow(&lanes(&b.lo), &lanes(&b.hi));
+    }
+
+    /// A copy built field by field: returned whole, a side is copied out with a `memcpy`
+    /// call on thumb targets, which links `memcpy`.
+    #[inline(always)]
+    fn copied(&self) -> Self {
+        Self {
+            count: self.count,
+            bin: self.bin,
+        }
     }
 
     fn bounds(&self) -> Aabb<S> {
         let (lo, hi) = (&self.bin.lo, &self.bin.hi);
         Aabb::new([lo[0], lo[1], lo[2]], [hi[0], hi[1], hi[2]])
     }
-
-    fn centroids(&self) -> Centroids {
-        let (lo, hi) = (self.centroid_lo.to_array(), self.centroid_hi.to_array());
-        ([lo[0], lo[1], lo[2]], [hi[0], hi[1], hi[2]])
-    }
 }
 
-struct Builder<'p, S, P, B> {
-    prims: &'p [P],
+/// Per-axis (min, max) of the [`key`]s of the boxes in `slots`.
+fn centroid_bounds<S: Scalar>(slots: &[Node<S>]) -> ([f32; 3], [f32; 3]) {
+    let (mut lo, mut hi) = (F4::splat(f32::INFINITY), F4::splat(f32::NEG_INFINITY));
+    for slot in slots {
+        let c = centroid(&lanes(&slot.lo), &lanes(&slot.hi));
+        lo = lo.min(c);
+        hi = hi.max(c);
+    }
+    let (lo, hi) = (lo.to_array(), hi.to_array());
+    ([lo[0], lo[1], lo[2]], [hi[0], hi[1], hi[2]])
+}
+
+/// The split rules, over arena slots each holding one primitive's box and id (`first`), with
+/// `count` free for a tag (the SAH bins of the primitive).
+struct Builder<S, B> {
     max_leaf: usize,
     /// Read for the split rule only: a constant for a [`super::StaticBuild`].
     settings: B,
@@ -352,115 +447,59 @@ fn lowest<S: Scalar>() -> S {
     S::from_f32_saturating(f32::NEG_INFINITY)
 }
 
-/// What the builder partitions: primitive ids, or cached (bounds, id) slots.
-trait Slot<S: Scalar>: Copy {
-    /// The primitive's id.
-    fn id(&self) -> u32;
-    /// The primitive's box, from the cache or recomputed.
-    fn bounds<P: Primitive<S>>(&self, prims: &[P]) -> Aabb<S>;
-    /// True if the slot keeps a tag (the SAH bins of its primitive).
-    const TAGGED: bool;
-    /// The tag last set (0 if the slot keeps none).
-    fn tag(&self) -> u32;
-    /// Sets the tag (a no-op if the slot keeps none).
-    fn set_tag(&mut self, tag: u32);
+/// Count and box of the boxes in `slots`.
+fn summarize<S: Scalar>(slots: &[Node<S>]) -> Side<S> {
+    let mut side = Side::empty();
+    for slot in slots {
+        side.add(&slot.bounds());
+    }
+    side.copied()
 }
 
-impl<S: Scalar> Slot<S> for u32 {
-    #[inline(always)]
-    fn id(&self) -> u32 {
-        *self
-    }
-    #[inline(always)]
-    fn bounds<P: Primitive<S>>(&self, prims: &[P]) -> Aabb<S> {
-        match prims.get(*self as usize) {
-            Some(p) => p.bounds(),
-            None => empty_box(),
+/// Partitions `slots` into those whose tag's field `(tag >> shift) & 31` (an SAH bin, or 0/1
+/// as [`tag_halves`] sets) is at most `last` and the rest, summarizing both sides on the way.
+/// One loop for every split rule, so a firmware links it once.
+fn partition_by<S: Scalar>(slots: &mut [Node<S>], shift: u32, last: u32) -> [Side<S>; 2] {
+    let mut sides = [Side::empty(), Side::empty()];
+    let (mut i, mut j) = (0, slots.len());
+    while i < j {
+        let Some(slot) = slots.get(i) else { break };
+        let b = slot.bounds();
+        if (slot.count >> shift) & 31 <= last {
+            sides[0].add(&b);
+            i += 1;
+        } else {
+            sides[1].add(&b);
+            j -= 1;
+            swap_in(slots, i, j);
         }
     }
-    const TAGGED: bool = false;
-    #[inline(always)]
-    fn tag(&self) -> u32 {
-        0
-    }
-    #[inline(always)]
-    fn set_tag(&mut self, _tag: u32) {}
+    [sides[0].copied(), sides[1].copied()]
 }
 
-impl<S: Scalar> Slot<S> for Node<S> {
-    #[inline(always)]
-    fn id(&self) -> u32 {
-        self.first
-    }
-    #[inline(always)]
-    fn bounds<P: Primitive<S>>(&self, _prims: &[P]) -> Aabb<S> {
-        Aabb::new(self.lo, self.hi)
-    }
-    // A cache slot's `count` is otherwise unused.
-    const TAGGED: bool = true;
-    #[inline(always)]
-    fn tag(&self) -> u32 {
-        self.count
-    }
-    #[inline(always)]
-    fn set_tag(&mut self, tag: u32) {
-        self.count = tag;
+/// Tags each slot 0 if its [`key`] on `axis` is below `bound` (`inclusive`: at most `bound`),
+/// else 1, for [`partition_by`] with `shift` 0 and `last` 0.
+fn tag_halves<S: Scalar>(slots: &mut [Node<S>], axis: usize, bound: f32, inclusive: bool) {
+    for slot in slots.iter_mut() {
+        let k = key(&slot.bounds(), axis);
+        let left = k < bound || (inclusive && k == bound);
+        slot.count = u32::from(!left);
     }
 }
 
-impl<S: Scalar, P: Primitive<S>, B: BuildSettings> Builder<'_, S, P, B> {
-    fn prim(&self, id: u32) -> Aabb<S> {
-        match self.prims.get(id as usize) {
-            Some(p) => p.bounds(),
-            None => empty_box(),
-        }
-    }
-
-    /// Count, box and centroid bounds of `ids`.
-    fn summarize<T: Slot<S>>(&self, ids: &[T]) -> Side<S> {
-        let mut side = Side::empty();
-        for id in ids {
-            side.add(&id.bounds(self.prims));
-        }
-        side
-    }
-
-    /// Partitions `ids` by `left`, summarizing both sides on the way.
-    fn partition_by<T: Slot<S>>(
+impl<S: Scalar, B: BuildSettings> Builder<S, B> {
+    /// Decides whether and where to split `slots` (partitioning them); `None` makes a leaf.
+    fn split(
         &self,
-        ids: &mut [T],
-        left: impl Fn(&T, &Aabb<S>) -> bool,
-    ) -> [Side<S>; 2] {
-        let mut sides = [Side::empty(), Side::empty()];
-        let (mut i, mut j) = (0, ids.len());
-        while i < j {
-            let Some(id) = ids.get(i) else { break };
-            let b = id.bounds(self.prims);
-            if left(id, &b) {
-                sides[0].add(&b);
-                i += 1;
-            } else {
-                sides[1].add(&b);
-                j -= 1;
-                swap_in(ids, i, j);
-            }
-        }
-        sides
-    }
-
-    /// Decides whether and where to split `ids` (partitioning them); `None` makes a leaf.
-    fn split<T: Slot<S>>(
-        &self,
-        ids: &mut [T],
+        slots: &mut [Node<S>],
         depth: usize,
-        centroids: &Centroids,
         bins: &mut Bins<'_, S>,
     ) -> Option<[Side<S>; 2]> {
-        let count = ids.len();
+        let count = slots.len();
         if count <= 1 {
             return None;
         }
-        let (clo, chi) = centroids;
+        let (clo, chi) = &centroid_bounds(slots);
         let extent: [f32; 3] = core::array::from_fn(|i| chi[i] - clo[i]);
         let widest = if extent[0] >= extent[1] && extent[0] >= extent[2] {
             0
@@ -471,44 +510,37 @@ impl<S: Scalar, P: Primitive<S>, B: BuildSettings> Builder<'_, S, P, B> {
         };
         let must_split = count > self.max_leaf;
         if depth >= MEDIAN_FALLBACK_DEPTH {
-            return must_split.then(|| self.median(ids, widest));
+            return must_split.then(|| median(slots, widest));
         }
         match self.settings.builder() {
-            BuilderKind::Median => must_split.then(|| self.median(ids, widest)),
+            BuilderKind::Median => must_split.then(|| median(slots, widest)),
             BuilderKind::Midpoint => must_split.then(|| {
                 let mid = clo[widest] * 0.5 + chi[widest] * 0.5;
-                let sides = self.partition_by(ids, |_, b| key(b, widest) < mid);
+                tag_halves(slots, widest, mid, false);
+                let sides = partition_by(slots, 0, 0);
                 if sides[0].count == 0 || sides[1].count == 0 {
-                    self.median(ids, widest)
+                    median(slots, widest)
                 } else {
                     sides
                 }
             }),
-            BuilderKind::Sah => match self.sah(ids, clo, &extent, bins) {
+            BuilderKind::Sah => match self.sah(slots, clo, &extent, bins) {
                 Some(sides) => Some(sides),
-                None => must_split.then(|| self.median(ids, widest)),
+                None => must_split.then(|| median(slots, widest)),
             },
         }
     }
 
-    fn median<T: Slot<S>>(&self, ids: &mut [T], axis: usize) -> [Side<S>; 2] {
-        let axis = axis.min(2);
-        let mid = ids.len() / 2;
-        select_nth(ids, mid, |id| (key(&id.bounds(self.prims), axis), id.id()));
-        let (left, right) = ids.split_at(mid);
-        [self.summarize(left), self.summarize(right)]
-    }
-
     /// Binned SAH over all three axes. `None` when a leaf is cheaper (and allowed) or no axis
     /// separates the centroids.
-    fn sah<T: Slot<S>>(
+    fn sah(
         &self,
-        ids: &mut [T],
+        slots: &mut [Node<S>],
         clo: &[f32; 3],
         extent: &[f32; 3],
         bins: &mut Bins<'_, S>,
     ) -> Option<[Side<S>; 2]> {
-        let count = ids.len();
+        let count = slots.len();
         // Small nodes use fewer bins: the same choices for less set-up work.
         let nb = count.clamp(4, BINS);
         let scale: [f32; 3] = core::array::from_fn(|a| {
@@ -519,24 +551,25 @@ impl<S: Scalar, P: Primitive<S>, B: BuildSettings> Builder<'_, S, P, B> {
                 0.0
             }
         });
-        if let [p, q] = ids {
-            let pair = [p.bounds(self.prims), q.bounds(self.prims)];
+        if let [p, q] = slots {
+            let pair = [p.bounds(), q.bounds()];
             let axis = self.sah_pair(pair, &scale)?.min(2); // `min`: shows the bound
-            return Some(self.partition_by(ids, |_, b| key(b, axis) <= clo[axis]));
+            tag_halves(slots, axis, clo[axis], true);
+            return Some(partition_by(slots, 0, 0));
         }
-        // Bin each primitive on all three axes, remembering its bins in the slot's tag (when it
-        // keeps one) for the partition below.
+        // Bin each primitive on all three axes, remembering its bins in the slot's tag for the
+        // partition below.
         let (origin, scale4) = (F4::new(lanes(clo)), F4::new(lanes(&scale)));
         let top = (nb - 1) as f32;
-        for id in ids.iter_mut() {
-            let b = id.bounds(self.prims);
+        for slot in slots.iter_mut() {
+            let b = slot.bounds();
             let (lo, hi) = (lanes(&b.lo), lanes(&b.hi));
             let bin = centroid(&lo, &hi)
                 .sub(origin)
                 .mul(scale4)
                 .clamped_trunc(top);
             // Each bin is below `nb <= 32`: five bits per axis.
-            id.set_tag(bin[0] | bin[1] << 5 | bin[2] << 10);
+            slot.count = bin[0] | bin[1] << 5 | bin[2] << 10;
             for ((boxes, counts), bin) in bins.boxes.iter_mut().zip(bins.counts.iter_mut()).zip(bin)
             {
                 // `% BINS` is a no-op (bins < nb <= BINS) that shows the compiler the bound.
@@ -551,20 +584,10 @@ impl<S: Scalar, P: Primitive<S>, B: BuildSettings> Builder<'_, S, P, B> {
         {
             return None;
         }
-        let axis = axis.min(2); // a no-op that shows the compiler the bound
-        let (shift, origin, scale) = (5 * axis, clo[axis], scale[axis]);
-        Some(self.partition_by(ids, |id, b| {
-            let bin = if T::TAGGED {
-                (id.tag() >> shift) as usize & 31
-            } else {
-                F4::splat((key(b, axis) - origin) * scale).clamped_trunc(top)[0] as usize
-            };
-            bin <= last_left_bin
-        }))
+        let shift = 5 * axis.min(2) as u32; // `min`: a no-op that shows the bound
+        Some(partition_by(slots, shift, last_left_bin as u32))
     }
-}
 
-impl<S: Scalar, P: Primitive<S>, B: BuildSettings> Builder<'_, S, P, B> {
     /// [`Builder::sah`] for two primitives with boxes `p`, `q`: the axis to split on, or `None`
     /// for a leaf (or no axis separating the centroids).
     ///
@@ -587,6 +610,15 @@ impl<S: Scalar, P: Primitive<S>, B: BuildSettings> Builder<'_, S, P, B> {
         }
         Some(axis)
     }
+}
+
+/// Splits `slots` at the median of their [`key`]s on `axis` (ties by id).
+fn median<S: Scalar>(slots: &mut [Node<S>], axis: usize) -> [Side<S>; 2] {
+    let axis = axis.min(2);
+    let mid = slots.len() / 2;
+    select_nth(slots, mid, |slot| (key(&slot.bounds(), axis), slot.first));
+    let (left, right) = slots.split_at(mid);
+    [summarize(left), summarize(right)]
 }
 
 /// Best SAH split over the bins (filled by [`Builder::sah`]): (cost, axis, last bin of the

@@ -1,11 +1,16 @@
 //! In-place, allocation-free, panic-free partitioning of primitive slots.
 
-/// Swaps `v[a]` and `v[b]`; a no-op if either index is out of range. Callers pass proven
-/// indices: the check only lets the compiler drop `swap`'s panic path.
+/// Swaps `v[a]` and `v[b]`; a no-op if either index is out of range or they are equal.
+/// Callers pass proven indices: the checks only let the compiler drop a panic path. Through
+/// two disjoint borrows rather than `slice::swap`, which may see one slot twice and so
+/// calls `memmove` on thumb targets for 32-byte slots.
 #[inline(always)]
 pub(super) fn swap_in<T>(v: &mut [T], a: usize, b: usize) {
-    if a < v.len() && b < v.len() {
-        v.swap(a, b);
+    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+    if let Some((left, right)) = v.split_at_mut_checked(hi) {
+        if let (Some(x), Some(y)) = (left.get_mut(lo), right.first_mut()) {
+            core::mem::swap(x, y);
+        }
     }
 }
 

@@ -1,9 +1,10 @@
 //! Size probe of the renderer: the default built-in scene (`f32`, the BVH family: one BVH per
 //! object, no other structure linked) converted
 //! into caller buffers, `Renderer::new`, and one row rendered to sRGB bytes; nothing else (no
-//! defmt, a spinning panic handler). `cargo xtask size` reports its `.text`/`.rodata` next to
-//! the build + traverse probe (`size_probe.rs`) and runs it under QEMU to measure its stack (the
-//! arrays below included): the only measuring code is the store to [`PROBE_DONE`].
+//! defmt, a spinning panic handler). `cargo xtask size` reports its `.text`/`.rodata`/`.bss` next
+//! to the build + traverse probe (`size_probe.rs`) and runs it under QEMU to measure its stack:
+//! the only measuring code is the store to [`PROBE_DONE`]. The scene's buffers are statics (in
+//! `.bss`, as firmware keeps them), so the stack measured is the renderer's own.
 #![no_std]
 #![no_main]
 
@@ -19,6 +20,17 @@ const TRIS: usize = 24;
 const SPHERES: usize = 4;
 const OBJECTS: usize = 8;
 const WIDTH: usize = 64;
+/// Every object's BVH, then the top-level BVH over the objects.
+const NODES: usize = nodes_needed(TRIS) + nodes_needed(SPHERES) + 4 * OBJECTS;
+const WORDS: usize = TRIS + SPHERES + OBJECTS;
+
+const NO_TRIANGLE: Triangle<f32> = Triangle { v: [[0.0; 3]; 3] };
+const NO_SPHERE: Sphere<f32> = Sphere {
+    center: [0.0; 3],
+    radius: 0.0,
+};
+const NO_OBJECT: Object<'static, f32> = Object::new(Shape::Triangles(&[]), 0);
+type Slot = ObjectSlot<'static, f32, BvhFamily>;
 
 /// Set to `DONE` when the row has been rendered; `cargo xtask size` polls it (in .bss).
 #[no_mangle]
@@ -27,28 +39,24 @@ static PROBE_DONE: AtomicU32 = AtomicU32::new(0);
 const DONE: u32 = 0x444f_4e45;
 
 #[inline(never)]
-fn render_row(data: &SceneData<'_>) -> Option<()> {
-    let mut tris = [Triangle::<f32> { v: [[0.0; 3]; 3] }; TRIS];
-    let mut spheres = [Sphere::<f32> {
-        center: [0.0; 3],
-        radius: 0.0,
-    }; SPHERES];
+fn render_row(data: &SceneData<'static>) -> Option<()> {
+    let tris = cortex_m::singleton!(: [Triangle<f32>; TRIS] = [NO_TRIANGLE; TRIS])?;
+    let spheres = cortex_m::singleton!(: [Sphere<f32>; SPHERES] = [NO_SPHERE; SPHERES])?;
     let tris = tris.get_mut(..data.triangles.len())?;
     let spheres = spheres.get_mut(..data.spheres.len())?;
     data.triangles_into(tris).ok()?;
     data.spheres_into(spheres).ok()?;
-    let mut objects = [Object::new(Shape::Triangles(&[]), 0); OBJECTS];
-    let scene = data.scene(tris, spheres, &mut objects).ok()?;
+    let objects = cortex_m::singleton!(: [Object<'static, f32>; OBJECTS] = [NO_OBJECT; OBJECTS])?;
+    let scene = data.scene(tris, spheres, objects).ok()?;
     // The BVH family: no other structure is linked.
-    let mut slots = [ObjectSlot::<f32, BvhFamily>::EMPTY; OBJECTS];
-    // Every object's BVH, then the top-level BVH over the objects.
-    let mut nodes = [Node::<f32>::EMPTY; nodes_needed(TRIS) + nodes_needed(SPHERES) + 4 * OBJECTS];
-    let mut ids = [0u32; TRIS + SPHERES + OBJECTS];
+    let slots = cortex_m::singleton!(: [Slot; OBJECTS] = [Slot::EMPTY; OBJECTS])?;
+    let nodes = cortex_m::singleton!(: [Node<f32>; NODES] = [Node::EMPTY; NODES])?;
+    let ids = cortex_m::singleton!(: [u32; WORDS] = [0; WORDS])?;
     let memory = RenderMemory {
-        objects: &mut slots,
+        objects: slots,
         accel: AccelMemory {
-            nodes: &mut nodes,
-            words: &mut ids,
+            nodes,
+            words: ids,
             ..AccelMemory::default()
         },
     };
