@@ -414,7 +414,8 @@ fn exact_edge(p: &[f32; 3], q: &[f32; 3]) -> f32 {
 /// decided exactly ([`exactly_zero`]).
 #[inline(always)]
 fn zero_area(v: &[[f32; 3]; 3]) -> bool {
-    const COMPONENTS: [(usize, usize); 3] = [(1, 2), (2, 0), (0, 1)];
+    const COMPONENTS: [(Axis, Axis); 3] =
+        [(Axis::Y, Axis::Z), (Axis::Z, Axis::X), (Axis::X, Axis::Y)];
     !COMPONENTS.iter().any(|&(i, j)| surely_non_zero(v, i, j))
         && COMPONENTS.iter().all(|&(i, j)| exactly_zero(v, i, j))
 }
@@ -422,27 +423,34 @@ fn zero_area(v: &[[f32; 3]; 3]) -> bool {
 /// True if component `(i, j)` of `(b - a) × (c - a)` evaluated in `f32` exceeds its rounding
 /// error bound (differences, products and their difference: under `4·2^-24` of the products'
 /// magnitudes, bounded here by `2^-21` of them plus `2^-120` for underflow), so is surely
-/// non-zero. Inlined on hosted targets (speed); bare-metal targets keep one copy (flash).
+/// non-zero. Inlined on hosted targets (speed; the three inlined calls share their edge
+/// differences); bare-metal targets keep one copy, which takes the four differences it needs
+/// on each call (flash: passing the edges in costs more code than the subtractions).
 #[cfg_attr(not(target_os = "none"), inline(always))]
 #[cfg_attr(target_os = "none", inline(never))]
-fn surely_non_zero(v: &[[f32; 3]; 3], i: usize, j: usize) -> bool {
+fn surely_non_zero(v: &[[f32; 3]; 3], i: Axis, j: Axis) -> bool {
     const REL: f32 = 1.0 / 2_097_152.0; // 2^-21
     const ABS: f32 = 7.523_164e-37; // 2^-120
-    let (i, j) = (i.min(2), j.min(2)); // no-ops that show the compiler the bounds
     let [a, b, c] = v;
-    let (p, q) = ((b[i] - a[i]) * (c[j] - a[j]), (b[j] - a[j]) * (c[i] - a[i]));
+    let edge = |p: &[f32; 3], k: Axis| axis(p, k) - axis(a, k);
+    let (p, q) = (edge(b, i) * edge(c, j), edge(b, j) * edge(c, i));
     abs(p - q) > (abs(p) + abs(q)) * REL + ABS
 }
 
 /// True if component `(i, j)` of `(b - a) × (c - a)` is exactly zero, decided by
 /// [`exact_sum_of_products`] over the six products of coordinates it equals
 /// (`a_i·b_j - a_j·b_i + b_i·c_j - b_j·c_i + c_i·a_j - c_j·a_i`).
-fn exactly_zero(v: &[[f32; 3]; 3], i: usize, j: usize) -> bool {
-    let (i, j) = (i.min(2), j.min(2)); // as above
+fn exactly_zero(v: &[[f32; 3]; 3], i: Axis, j: Axis) -> bool {
     let [a, b, c] = v;
-    let x = [a[i], -a[j], b[i], -b[j], c[i], -c[j]];
-    let y = [b[j], b[i], c[j], c[i], a[j], a[i]];
-    exact_sum_of_products(x, y) == 0.0
+    let (ai, aj, bi, bj, ci, cj) = (
+        axis(a, i),
+        axis(a, j),
+        axis(b, i),
+        axis(b, j),
+        axis(c, i),
+        axis(c, j),
+    );
+    exact_sum_of_products([ai, -aj, bi, -bj, ci, -cj], [bj, bi, cj, ci, aj, ai]) == 0.0
 }
 
 /// The slab test of one box: the IEEE operations of one lane of [`Scalar::slab_pair`], in the
