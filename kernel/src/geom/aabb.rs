@@ -47,6 +47,8 @@ impl<S: Scalar> Aabb<S> {
 
 /// [`Aabb::contains`] on corners where they are stored (a node's, say), so no box is copied to
 /// ask: true if the box `inner_lo..inner_hi` lies inside `lo..hi`, boundaries included.
+/// Bare-metal targets keep one copy (flash: the tree checks call it from two places).
+#[cfg_attr(target_os = "none", inline(never))]
 pub(crate) fn corners_contain<S: Scalar>(
     (lo, hi): (&[S; 3], &[S; 3]),
     (inner_lo, inner_hi): (&[S; 3], &[S; 3]),

@@ -19,7 +19,7 @@ pub(crate) use sqrt::sqrtf;
 use super::lanes::F4;
 use super::Scalar;
 use crate::error::{PointError, RayError};
-use eft::{exact_sum_of_products, recip_binade, scale_to_2_60, Df};
+use eft::{exact_cross_sum, recip_binade, scale_to_2_60, Df};
 
 /// Largest coordinate magnitude accepted in `f32` mode (2^40, about 1.1e12). Beyond it the
 /// triple products of the triangle test could overflow to infinity and silently lose hits.
@@ -399,25 +399,22 @@ impl FloatRay {
 }
 
 /// `p0·q1 - p1·q0` as a value with its exact sign, zero exactly when it is zero
-/// ([`exact_sum_of_products`]). Swapping `p` and `q` negates the result exactly, so a shared
-/// edge is seen with opposite signs from its two triangles (watertightness).
+/// ([`exact_cross`] with a zero third point). Swapping `p` and `q` negates the result exactly,
+/// so a shared edge is seen with opposite signs from its two triangles (watertightness).
 #[inline(never)]
 fn exact_edge(p: &[f32; 3], q: &[f32; 3]) -> f32 {
-    exact_sum_of_products(
-        [p[0], -p[1], 0.0, 0.0, 0.0, 0.0],
-        [q[1], q[0], 0.0, 0.0, 0.0, 0.0],
-    )
+    exact_cross(&[*p, *q, [0.0; 3]], Axis::X, Axis::Y)
 }
 
 /// True if the triangle has exactly zero area: `(b - a) × (c - a) = 0`. Each component is
 /// first evaluated in `f32` ([`surely_non_zero`]); only if none is surely non-zero are they
-/// decided exactly ([`exactly_zero`]).
+/// decided exactly ([`exact_cross`]).
 #[inline(always)]
 fn zero_area(v: &[[f32; 3]; 3]) -> bool {
     const COMPONENTS: [(Axis, Axis); 3] =
         [(Axis::Y, Axis::Z), (Axis::Z, Axis::X), (Axis::X, Axis::Y)];
     !COMPONENTS.iter().any(|&(i, j)| surely_non_zero(v, i, j))
-        && COMPONENTS.iter().all(|&(i, j)| exactly_zero(v, i, j))
+        && COMPONENTS.iter().all(|&(i, j)| exact_cross(v, i, j) == 0.0)
 }
 
 /// True if component `(i, j)` of `(b - a) × (c - a)` evaluated in `f32` exceeds its rounding
@@ -437,20 +434,20 @@ fn surely_non_zero(v: &[[f32; 3]; 3], i: Axis, j: Axis) -> bool {
     abs(p - q) > (abs(p) + abs(q)) * REL + ABS
 }
 
-/// True if component `(i, j)` of `(b - a) × (c - a)` is exactly zero, decided by
-/// [`exact_sum_of_products`] over the six products of coordinates it equals
-/// (`a_i·b_j - a_j·b_i + b_i·c_j - b_j·c_i + c_i·a_j - c_j·a_i`).
-fn exactly_zero(v: &[[f32; 3]; 3], i: Axis, j: Axis) -> bool {
+/// Component `(i, j)` of `a × b + b × c + c × a`, which is that of `(b - a) × (c - a)`, with its
+/// exact sign, zero exactly when it is zero ([`exact_cross_sum`]). One copy in flash for every
+/// exact decision of the triangle test: its callers pass the points and axes, not the factors.
+#[inline(never)]
+fn exact_cross(v: &[[f32; 3]; 3], i: Axis, j: Axis) -> f32 {
     let [a, b, c] = v;
-    let (ai, aj, bi, bj, ci, cj) = (
+    exact_cross_sum([
         axis(a, i),
         axis(a, j),
         axis(b, i),
         axis(b, j),
         axis(c, i),
         axis(c, j),
-    );
-    exact_sum_of_products([ai, -aj, bi, -bj, ci, -cj], [bj, bi, cj, ci, aj, ai]) == 0.0
+    ])
 }
 
 /// The slab test of one box: the IEEE operations of one lane of [`Scalar::slab_pair`], in the
@@ -539,7 +536,8 @@ impl Scalar for f32 {
 
     fn pad_bounds(lo: [f32; 3], hi: [f32; 3]) -> ([f32; 3], [f32; 3]) {
         let d = margin_offset(max_abs(&lo).max_of(max_abs(&hi)));
-        (lo.map(|x| x - d), hi.map(|x| x + d))
+        let ([a, b, c], [x, y, z]) = (lo, hi);
+        ([a - d, b - d, c - d], [x + d, y + d, z + d])
     }
 
     #[inline(always)]

@@ -19,9 +19,18 @@ pub use float::F32_COORD_LIMIT;
 use core::fmt::Debug;
 
 mod sealed {
-    pub trait Sealed {}
-    impl Sealed for f32 {}
-    impl Sealed for super::I16F16 {}
+    /// What only the two modes implement, and only the kernel reads.
+    pub trait Sealed: Sized {
+        /// The lowest value: `-inf` for `f32`, the most negative one for fixed point. Below or
+        /// equal to every value, so `LOWEST.max_of(x)` is `x`, bit for bit.
+        const LOWEST: Self;
+    }
+    impl Sealed for f32 {
+        const LOWEST: f32 = f32::NEG_INFINITY;
+    }
+    impl Sealed for super::I16F16 {
+        const LOWEST: Self = super::I16F16(i32::MIN);
+    }
 }
 
 /// The number type the kernel computes in. Implemented for `f32` and [`I16F16`] only.

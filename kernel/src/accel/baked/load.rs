@@ -2,7 +2,7 @@
 
 use super::error::BakeError;
 use super::format::{checked_header, BakedKind, Header};
-use super::plain::{cast_slice, Plain};
+use super::plain::{cast_section, Plain};
 use super::scalar::BakedScalar;
 use crate::accel::bvh::{Bvh, Node};
 use crate::accel::bvh4::{Bvh4, Node4};
@@ -55,13 +55,12 @@ fn sections<S: BakedScalar, N: Plain>(
     if (bytes.as_ptr() as usize) % kind.align() != 0 {
         return Err(misaligned);
     }
-    let section = |range: core::ops::Range<usize>| bytes.get(range).ok_or(misaligned);
     // Cannot fail: `checked_header` checked the layout against the length, and the alignment
     // is checked above.
-    let nodes = cast_slice::<N>(section(layout.nodes..layout.ids)?).ok_or(misaligned)?;
-    let ids = cast_slice::<u32>(section(layout.ids..layout.prims)?).ok_or(misaligned)?;
-    let prims =
-        cast_slice::<Triangle<S>>(section(layout.prims..layout.total)?).ok_or(misaligned)?;
+    let (nodes, prims) = (header.node_count as usize, header.prim_count as usize);
+    let nodes = cast_section::<N>(bytes, layout.nodes, nodes).ok_or(misaligned)?;
+    let ids = cast_section::<u32>(bytes, layout.ids, prims).ok_or(misaligned)?;
+    let prims = cast_section::<Triangle<S>>(bytes, layout.prims, prims).ok_or(misaligned)?;
     for (index, t) in (0u32..).zip(prims) {
         if t.check().is_err() {
             return Err(BakeError::BadPrimitive { index });

@@ -52,20 +52,20 @@ const _: () = {
     assert!(size_of::<Node<I16F16>>() == 32 && size_of::<Node4<I16F16>>() == 128);
 };
 
-/// `bytes` as a slice of `T`, if its start is aligned for `T`, its length a multiple of
-/// `T`'s size, and the target little-endian. Zero-sized `T` never occurs (all are 4+ bytes).
-pub(crate) fn cast_slice<T: Plain>(bytes: &[u8]) -> Option<&[T]> {
-    let size = core::mem::size_of::<T>();
-    let aligned = (bytes.as_ptr() as usize) % core::mem::align_of::<T>() == 0;
-    if cfg!(target_endian = "big") || size == 0 || !aligned || bytes.len() % size != 0 {
+/// The `count` values of `T` stored from byte `start` of `bytes`, in place, if they lie within
+/// `bytes`, their start is aligned for `T` and the target is little-endian.
+pub(crate) fn cast_section<T: Plain>(bytes: &[u8], start: usize, count: usize) -> Option<&[T]> {
+    let len = count.checked_mul(core::mem::size_of::<T>())?;
+    let section = bytes.get(start..start.checked_add(len)?)?;
+    let aligned = (section.as_ptr() as usize) % core::mem::align_of::<T>() == 0;
+    if cfg!(target_endian = "big") || !aligned {
         return None;
     }
-    let len = bytes.len() / size;
     // SAFETY: the pointer is non-null, aligned for `T` (checked) and valid for reads of
-    // `len * size_of::<T>()` bytes (the whole of `bytes`) for the lifetime of `bytes`, which
+    // `count * size_of::<T>()` bytes (the whole of `section`) for the lifetime of `bytes`, which
     // nobody can mutate meanwhile (shared borrow; `T` has no interior mutability). Every bit
     // pattern is a valid `T` (`Plain`).
     #[allow(unsafe_code)]
-    let slice = unsafe { core::slice::from_raw_parts(bytes.as_ptr().cast::<T>(), len) };
+    let slice = unsafe { core::slice::from_raw_parts(section.as_ptr().cast::<T>(), count) };
     Some(slice)
 }

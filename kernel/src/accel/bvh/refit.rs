@@ -99,15 +99,22 @@ pub(crate) fn leaf_bounds<S: Scalar, P: Primitive<S>>(
     (first, count): (usize, usize),
 ) -> Option<Aabb<S>> {
     let ids = prim_ids.get(first..first.checked_add(count)?)?;
-    let mut union: Option<Aabb<S>> = None;
+    ids.first()?;
+    // Grown in place from the empty box: `FAR.min_of(x)` and `LOWEST.max_of(x)` are `x`, so
+    // the first union is the first box, bit for bit, and no box is copied.
+    let mut lo = [S::FAR; 3];
+    let mut hi = [S::LOWEST; 3];
     for (slot, &id) in (first..).zip(ids) {
         let b = prims
             .get(if leaf_order { slot } else { id as usize })?
             .bounds();
-        union = Some(union.map_or(b, |u| u.union(&b)));
+        for i in 0..3 {
+            lo[i] = lo[i].min_of(b.lo[i]);
+            hi[i] = hi[i].max_of(b.hi[i]);
+        }
     }
-    let (lo, hi) = union.map(|u| S::pad_bounds(u.lo, u.hi))?;
-    Some(Aabb::new(lo, hi))
+    let (lo, hi) = S::pad_bounds(lo, hi);
+    Some(Aabb { lo, hi })
 }
 
 impl<'a, S: Scalar, P: Primitive<S>> Bvh<'a, S, P> {

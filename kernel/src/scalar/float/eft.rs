@@ -13,7 +13,6 @@
 //! "none"`) leave it to the optimiser, which keeps one copy of the larger helpers (flash).
 
 use super::max_abs;
-use crate::scalar::Scalar;
 
 /// `(s, e)` with `s = fl(a + b)` and `s + e = a + b` exactly (Knuth's branch-free TwoSum).
 #[inline(always)]
@@ -147,26 +146,30 @@ pub(crate) fn scale_to_2_60(m: f32) -> (f32, f32) {
     }
 }
 
-/// `x[0]·y[0] + ... + x[5]·y[5]` as a value with its exact sign, zero exactly when it is zero
-/// (inputs below 2^44 in magnitude; exact unless both factors of one product lie over 2^110
-/// below the largest input, where a product's error term would underflow).
+/// `ai·bj - aj·bi + bi·cj - bj·ci + ci·aj - cj·ai` for `f = [ai, aj, bi, bj, ci, cj]` (component
+/// `(i, j)` of `a × b + b × c + c × a`) as a value with its exact sign, zero exactly when it is
+/// zero (inputs below 2^44 in magnitude; exact unless both factors of one product lie over
+/// 2^110 below the largest input, where a product's error term would underflow).
 ///
 /// Every input is scaled by one power of two that brings the largest up to the binade 2^60
 /// ([`scale_to_2_60`]), so the products keep their error terms; the six products are taken as
-/// exact pairs ([`two_prod`]) and the sign of their twelve-term sum by [`exact_sum_sign`]. Odd:
-/// negating every `x` negates the result exactly. The exact fallback of every sign decision of
-/// the triangle test.
-#[inline(never)]
-pub(crate) fn exact_sum_of_products(x: [f32; 6], y: [f32; 6]) -> f32 {
-    let m = max_abs(&x).max_of(max_abs(&y));
+/// exact pairs ([`two_prod`]) and the sign of their twelve-term sum by [`exact_sum_sign`].
+/// Swapping the first two points negates the result exactly when `c` is zero (the 2D edge
+/// function). The exact fallback of every sign decision of the triangle test.
+#[inline(always)]
+pub(crate) fn exact_cross_sum(f: [f32; 6]) -> f32 {
+    let m = max_abs(&f);
     if m == 0.0 {
         return 0.0;
     }
     let (k1, k2) = scale_to_2_60(m);
-    let k = |v: f32| v * k1 * k2;
-    // The twelve terms: each product and its error, in order.
+    let s = f.map(|v| v * k1 * k2);
+    // Product `n` is `±s[n]·s[PARTNER[n]]`, negative for odd `n`: ai·bj, -aj·bi, bi·cj, -bj·ci,
+    // ci·aj, -cj·ai. The twelve terms: each product and its error, in order.
+    const PARTNER: [usize; 6] = [3, 2, 5, 4, 1, 0];
     let mut terms: [[f32; 2]; 6] = core::array::from_fn(|n| {
-        let (p, e) = two_prod(k(x[n]), k(y[n]));
+        let x = if n % 2 == 0 { s[n] } else { -s[n] };
+        let (p, e) = two_prod(x, s[PARTNER[n]]);
         [p, e]
     });
     exact_sum_sign(terms.as_flattened_mut())
@@ -186,7 +189,8 @@ pub(crate) fn exact_sum_sign(terms: &mut [f32]) -> f32 {
         let mut moved = false;
         for i in 1..n {
             let (s, e) = two_sum(terms[i], terms[i - 1]);
-            moved |= s != terms[i] || e != terms[i - 1];
+            // `s + e` is exactly the old pair's sum, so `s` moved if and only if `e` did.
+            moved |= e != terms[i - 1];
             terms[i] = s;
             terms[i - 1] = e;
         }
@@ -273,43 +277,60 @@ mod tests {
     }
 
     #[test]
-    fn exact_sum_of_products_has_the_exact_sign() {
+    fn exact_cross_sum_has_the_exact_sign() {
         let mut st = 0xd1ff_0f9a_0d00_0017;
-        // Values within 2^±16 are multiples of 2^-39 below 2^17 (halved or doubled: 2^-40,
-        // 2^18): scaled by 2^40 each, the products are integers below 2^115.
+        // Random values within 2^±16 are multiples of 2^-39 below 2^17, grid values (below)
+        // multiples of 2^-10 below 2^21: scaled by 2^40 each, the products are integers below
+        // 2^122, summed exactly in i128.
         let scale = libm::exp2(40.0);
         let fixed = |v: f32| (v as f64 * scale) as i128;
+        // Small integers times one power of two: sums of a few stay exact in f32.
+        let grid =
+            |st: &mut u64, e: i32| ((next(st) % 2001) as f32 - 1000.0) * libm::exp2f(e as f32);
         for i in 0..50_000 {
-            let mut x: [f32; 6] = core::array::from_fn(|_| value(&mut st, 16));
-            let mut y: [f32; 6] = core::array::from_fn(|_| value(&mut st, 16));
-            match i % 4 {
-                // Exact cancellation: the last three products are the first three negated
-                // (some halved and doubled).
-                0 => {
-                    for k in 0..3 {
-                        (x[k + 3], y[k + 3]) = (-x[k] * 2.0, y[k] * 0.5);
+            let mut f: [f32; 6] = core::array::from_fn(|_| value(&mut st, 16));
+            let e = (next(&mut st) % 20) as i32 - 10;
+            match i % 5 {
+                // Collinear points (c - a = 2·(b - a), exactly): an exact zero.
+                0 | 1 => {
+                    let a = [grid(&mut st, e), grid(&mut st, e)];
+                    let d = [grid(&mut st, e), grid(&mut st, e)];
+                    let (b, c) = (
+                        [a[0] + d[0], a[1] + d[1]],
+                        [a[0] + 2.0 * d[0], a[1] + 2.0 * d[1]],
+                    );
+                    f = [a[0], a[1], b[0], b[1], c[0], c[1]];
+                    // Nearly collinear: one coordinate off by one unit in the last place.
+                    if i % 5 == 1 && f[5] != 0.0 {
+                        f[5] = f32::from_bits(f[5].to_bits() + 1);
                     }
                 }
-                // Near cancellation: off by one unit in the last place of one factor.
-                1 => {
-                    for k in 0..3 {
-                        (x[k + 3], y[k + 3]) = (-x[k], y[k]);
-                    }
-                    y[5] = f32::from_bits(y[5].to_bits() + 1);
-                }
-                // Zeros, as the 2D edge function passes them.
+                // A zero third point, as the 2D edge function passes it.
                 2 => {
-                    for k in 2..6 {
-                        (x[k], y[k]) = (0.0, 0.0);
-                    }
+                    f[4] = 0.0;
+                    f[5] = 0.0;
+                }
+                // Nearly collinear full-precision points a, 3a and 5a, rounded: the exact sum
+                // is a few units in the last place of the products, which rounded products get
+                // wrong; only their error terms carry the sign.
+                3 => {
+                    let [x, y] = [f[0], f[1]];
+                    f = [x, y, 3.0 * x, 3.0 * y, 5.0 * x, 5.0 * y];
                 }
                 _ => {}
             }
-            let exact: i128 = x.iter().zip(&y).map(|(&a, &b)| fixed(a) * fixed(b)).sum();
-            let got = exact_sum_of_products(x, y);
-            assert_eq!(got > 0.0, exact > 0, "{x:?} {y:?}");
-            assert_eq!(got == 0.0, exact == 0, "{x:?} {y:?}");
-            assert_eq!(exact_sum_of_products(x.map(|v| -v), y), -got);
+            let [ai, aj, bi, bj, ci, cj] = f.map(fixed);
+            let exact = ai * bj - aj * bi + bi * cj - bj * ci + ci * aj - cj * ai;
+            let got = exact_cross_sum(f);
+            assert_eq!(got > 0.0, exact > 0, "{f:?}");
+            assert_eq!(got == 0.0, exact == 0, "{f:?}");
+            if i % 5 == 2 {
+                assert_eq!(
+                    exact_cross_sum([f[2], f[3], f[0], f[1], 0.0, 0.0]),
+                    -got,
+                    "{f:?}"
+                );
+            }
         }
     }
 
