@@ -59,7 +59,9 @@ pub use accel::{
 };
 pub use geom::{spawn, Aabb, Hit, Primitive, Ray, Sphere, Triangle};
 pub use glam;
-pub use scalar::{PointError, RayError, Scalar, Vec3x, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16};
+pub use scalar::{
+    PointError, RayData, RayError, Scalar, Vec3x, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16,
+};
 
 /// Settings, memory sizes and limits of the binary BVH, [`Bvh`].
 pub mod bvh {

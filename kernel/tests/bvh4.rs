@@ -1,5 +1,5 @@
 //! The 4-wide BVH beyond the random differential tests of `properties.rs`:
-//! - `Scalar::slab4` gives, box by box, exactly `Scalar::slab`'s decisions and entry bits
+//! - `Numerics::slab4` gives, box by box, exactly `Numerics::slab`'s decisions and entry bits
 //!   (random boxes and rays, zero and signed-zero direction components, origins on box
 //!   planes, flat boxes, intervals);
 //! - why unused slots are masked by their count rather than by an "empty" box: the slab test
@@ -14,7 +14,7 @@ use common::{c, query, same_hit, with_bvh, with_bvh4, RaySpec, TestScalar, LEAF_
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
 use raykernel::Arena;
-use raykernel::{Accel, BuildError, Bvh, Bvh4, Linear, Node, Node4, Ray, Scalar, Triangle, I16F16};
+use raykernel::{Aabb, Accel, BuildError, Bvh, Bvh4, Linear, Node, Node4, Ray, Triangle, I16F16};
 use raykernel_testkit::icosphere::unit_icosphere;
 use raykernel_testkit::Rng;
 
@@ -182,7 +182,7 @@ fn slab_accepts_an_inverted_infinite_box_so_unused_slots_need_a_mask() {
     let ray = Ray::<f32>::from_f32([0.0; 3], [1.0, 0.0, 0.0], 0.0, f32::INFINITY).unwrap();
     let lo = [f32::INFINITY; 3];
     let hi = [f32::NEG_INFINITY; 3];
-    assert!(f32::slab(ray.data(), &lo, &hi, ray.t_min(), ray.t_max()).is_some());
+    assert!(Aabb::new(lo, hi).slab(&ray).is_some());
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1,5 +1,5 @@
 //! The uniform grid and the kd-tree beyond the random differential tests of `properties.rs`:
-//! - `Scalar::slab_axis` recombines to exactly `Scalar::slab` (the grid walk's foundation);
+//! - `Numerics::slab_axis` recombines to exactly `Numerics::slab` (the grid walk's foundation);
 //! - degenerate scenes (no primitives, one, all in one cell, flat, a single huge triangle among
 //!   small ones, zero-area triangles, coincident spheres) build without panicking, validate,
 //!   and answer like brute force bit for bit, in both modes;

@@ -16,8 +16,8 @@ use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::spawn::{offset_origin, spawn_ray, spawn_shadow_ray, SpawnScalar};
 use raykernel::{
     grid::GridOptions, kdtree::KdOptions, Aabb, Accel, AccelKind, AccelVisitor, AnyAccel, Arena,
-    BuildError, Bvh, Hit, Linear, Node, PointError, Primitive, Ray, RayError, Scalar, Triangle,
-    Vec3x, I16F16,
+    BuildError, Bvh, Hit, Linear, Node, PointError, Primitive, Ray, RayData, RayError, Scalar,
+    Triangle, Vec3x, I16F16,
 };
 use raykernel_testkit::icosphere::unit_icosphere;
 use raykernel_testkit::memory::OwnedMemory;
@@ -241,12 +241,12 @@ impl Primitive<f32> for MtTri {
     fn check(&self) -> Result<(), (usize, PointError)> {
         self.0.check()
     }
-    fn hit_t(&self, ray: &<f32 as Scalar>::RayData, t_min: f32, t_max: f32) -> Option<f32> {
+    fn hit_t(&self, ray: &RayData<f32>, t_min: f32, t_max: f32) -> Option<f32> {
         let o = <f32 as Scalar>::ray_origin(ray);
         let d = <f32 as Scalar>::ray_dir(ray);
         mt_t(o, d, &self.0.v, t_min, t_max)
     }
-    fn hit_uv(&self, _ray: &<f32 as Scalar>::RayData) -> (f32, f32) {
+    fn hit_uv(&self, _ray: &RayData<f32>) -> (f32, f32) {
         (0.0, 0.0)
     }
 }

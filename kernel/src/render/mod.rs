@@ -3,7 +3,7 @@
 //! the shutter interval. `no_std`, no allocation, both number modes.
 //!
 //! - The caller owns the scene ([`Scene`]: objects, materials, lights, camera) and the memory
-//!   ([`AccelMemory`] for the accelerators, sized by [`memory_needed`]; the framebuffer).
+//!   ([`AccelMemory`](crate::AccelMemory) for the accelerators, sized by [`memory_needed`]; the framebuffer).
 //! - [`Renderer::new`] checks the scene (typed [`SceneError`]s), builds one accelerator per
 //!   object and derives the [`RenderPlan`]: the features the scene and settings need. Features
 //!   the plan leaves out cost a branch, not work.

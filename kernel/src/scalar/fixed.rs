@@ -11,6 +11,7 @@
 //! - slab test: `(plane - origin) · (2^62 / d) >> 32` in `i128`, padded by 2 raw units each way,
 //!   which bounds the rounding of the reciprocal, so boxes are never culled wrongly.
 
+use super::sealed::Numerics;
 use super::Scalar;
 use super::{PointError, RayError};
 use core::ops::{Add, Div, Mul, Neg, Sub};
@@ -282,7 +283,6 @@ fn t_in_range(t: i128, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
 
 impl Scalar for I16F16 {
     type Vec3 = Vec3x;
-    type RayData = FixedRay;
 
     const ZERO: Self = Self(0);
     const FAR: Self = Self::MAX;
@@ -317,6 +317,18 @@ impl Scalar for I16F16 {
             check_raw(r.0)
         }
     }
+    fn ray_origin(ray: &FixedRay) -> [Self; 3] {
+        ray.origin.map(|x| I16F16(x as i32))
+    }
+    fn ray_dir(ray: &FixedRay) -> [Self; 3] {
+        // Q2.30 -> Q16.16, rounded.
+        ray.dir.map(|d| I16F16(((d + (1 << 13)) >> 14) as i32))
+    }
+}
+
+impl Numerics for I16F16 {
+    type RayData = FixedRay;
+    const LOWEST: Self = I16F16(i32::MIN);
 
     fn ray_data(origin: [Self; 3], dir: [Self; 3]) -> Result<FixedRay, RayError> {
         Self::check_point(origin).map_err(RayError::Origin)?;
@@ -339,13 +351,6 @@ impl Scalar for I16F16 {
         let mut r = *ray;
         r.set_dir(super::float::unit_dir_from_f32(dir)?);
         Ok(r)
-    }
-    fn ray_origin(ray: &FixedRay) -> [Self; 3] {
-        ray.origin.map(|x| I16F16(x as i32))
-    }
-    fn ray_dir(ray: &FixedRay) -> [Self; 3] {
-        // Q2.30 -> Q16.16, rounded.
-        ray.dir.map(|d| I16F16(((d + (1 << 13)) >> 14) as i32))
     }
 
     fn pad_bounds(lo: [Self; 3], hi: [Self; 3]) -> ([Self; 3], [Self; 3]) {

@@ -17,6 +17,7 @@ mod sqrt;
 pub(crate) use sqrt::sqrtf;
 
 use super::lanes::F4;
+use super::sealed::Numerics;
 use super::Scalar;
 use crate::error::{PointError, RayError};
 use eft::{exact_cross_sum, recip_binade, scale_to_2_60, Df};
@@ -35,7 +36,7 @@ pub const F32_COORD_LIMIT: f32 = 1_099_511_627_776.0;
 /// one parametrisation whatever `|dir|` is. The normalisation error (see [`unit_dir`]) only
 /// makes `t` a distance to within a relative 2^-22.
 const MARGIN: f32 = 1.0 / 524_288.0;
-/// The factor of [`Scalar::widen`]: exits up to `(1 + 2·MARGIN)·t` count as inside.
+/// The factor of `Numerics::widen`: exits up to `(1 + 2·MARGIN)·t` count as inside.
 const WIDEN: f32 = 1.0 + 2.0 * MARGIN;
 
 /// Per-ray data for `f32` mode. Built only by [`crate::Ray`]'s constructors.
@@ -450,7 +451,7 @@ fn exact_cross(v: &[[f32; 3]; 3], i: Axis, j: Axis) -> f32 {
     ])
 }
 
-/// The slab test of one box: the IEEE operations of one lane of [`Scalar::slab_pair`], in the
+/// The slab test of one box: the IEEE operations of one lane of `Numerics::slab_pair`, in the
 /// same order, so the same bits. Bare-metal targets run it once per box: their lanes are
 /// scalar code anyway, and one copy of it is the smallest in flash.
 #[cfg_attr(not(target_os = "none"), inline(always))]
@@ -469,7 +470,6 @@ fn slab_box(r: &FloatRay, (lo, hi): (&[f32; 3], &[f32; 3]), t_min: f32, t_max: f
 
 impl Scalar for f32 {
     type Vec3 = glam::Vec3;
-    type RayData = FloatRay;
 
     const ZERO: Self = 0.0;
     const FAR: Self = f32::INFINITY;
@@ -505,6 +505,17 @@ impl Scalar for f32 {
             Ok(())
         }
     }
+    fn ray_origin(ray: &FloatRay) -> [f32; 3] {
+        ray.origin
+    }
+    fn ray_dir(ray: &FloatRay) -> [f32; 3] {
+        ray.dir
+    }
+}
+
+impl Numerics for f32 {
+    type RayData = FloatRay;
+    const LOWEST: f32 = f32::NEG_INFINITY;
 
     // On hosted targets the ray constructors are inlined down to `FloatRay::new`, so a ray is
     // built where it is stored. Returned through memory and then moved into the `Ray`, it was
@@ -526,12 +537,6 @@ impl Scalar for f32 {
     #[cfg_attr(not(target_os = "none"), inline(always))]
     fn ray_redirected_f32(ray: &FloatRay, dir: [f32; 3]) -> Result<FloatRay, RayError> {
         FloatRay::along(ray.origin, ray.o_lo, ray.o_hi, dir)
-    }
-    fn ray_origin(ray: &FloatRay) -> [f32; 3] {
-        ray.origin
-    }
-    fn ray_dir(ray: &FloatRay) -> [f32; 3] {
-        ray.dir
     }
 
     fn pad_bounds(lo: [f32; 3], hi: [f32; 3]) -> ([f32; 3], [f32; 3]) {
@@ -820,7 +825,7 @@ mod tests {
             let lo: [f32; 3] = core::array::from_fn(|i| p[i].min_of(q[i]));
             let hi: [f32; 3] = core::array::from_fn(|i| p[i].max_of(q[i]));
             let m = (0..3).fold(0.0f32, |m, i| m.max_of(abs(lo[i])).max_of(abs(hi[i])));
-            let (plo, phi) = <f32 as Scalar>::pad_bounds(lo, hi);
+            let (plo, phi) = <f32 as Numerics>::pad_bounds(lo, hi);
             for i in 0..3 {
                 assert!(plo[i] == shift(lo[i], m * MARGIN, false) && plo[i] < lo[i]);
                 assert!(phi[i] == shift(hi[i], m * MARGIN, true) && phi[i] > hi[i]);
@@ -903,7 +908,7 @@ mod tests {
             let lo2: [f32; 3] = core::array::from_fn(|i| u[i].min_of(w[i]));
             let hi2: [f32; 3] = core::array::from_fn(|i| u[i].max_of(w[i]));
             let t_max = [f32::INFINITY, 1.0, 3.5][(next(&mut st) % 3) as usize];
-            let pair = <f32 as Scalar>::slab_pair(&r, (&lo1, &hi1), (&lo2, &hi2), 0.0, t_max);
+            let pair = <f32 as Numerics>::slab_pair(&r, (&lo1, &hi1), (&lo2, &hi2), 0.0, t_max);
             let single = [
                 slab_box(&r, (&lo1, &hi1), 0.0, t_max),
                 slab_box(&r, (&lo2, &hi2), 0.0, t_max),

@@ -1,9 +1,11 @@
 //! The two number modes: `f32` and the fixed-point [`I16F16`].
 //!
 //! Every algorithm above this module (builders, traversal, queries) is written once, generic over
-//! [`Scalar`]. What must differ between the modes lives here, behind the trait: how a ray is
-//! prepared, the conservative slab test, and the exact-as-possible primitive tests. Each mode's
-//! numerics sit in its own file (`float.rs`, `fixed.rs`).
+//! [`Scalar`]. What must differ between the modes lives here: the public trait holds what a caller
+//! needs (constants, conversions, checks); its sealed supertrait `Numerics` holds how a ray is
+//! prepared, the conservative slab test and the exact-as-possible primitive tests, which the
+//! kernel reaches through `S: Scalar` and callers never name. Each mode's numerics sit in its
+//! own file (`float.rs`, `fixed.rs`).
 
 mod error;
 mod fixed;
@@ -18,20 +20,148 @@ pub use float::F32_COORD_LIMIT;
 
 use core::fmt::Debug;
 
-mod sealed {
-    /// What only the two modes implement, and only the kernel reads.
-    pub trait Sealed: Sized {
+/// The per-mode numerics behind [`Scalar`]: ray preparation, the conservative slab test, the
+/// primitive tests. Sealed (implemented for the two modes only) and not part of the public API.
+pub(crate) mod sealed {
+    use super::RayError;
+    use core::fmt::Debug;
+
+    /// Ray preparation, slab tests and primitive tests of one mode; a supertrait of [`Scalar`],
+    /// so everything generic over `S: Scalar` calls them as `S::slab(..)`.
+    ///
+    /// [`Scalar`]: super::Scalar
+    pub trait Numerics: Copy + PartialEq + PartialOrd + Debug + Send + Sync + 'static {
+        /// Per-ray data precomputed once by [`crate::Ray`]'s constructors for the box and
+        /// primitive tests (public as [`crate::RayData`]).
+        type RayData: Copy + Debug + Send + Sync;
         /// The lowest value: `-inf` for `f32`, the most negative one for fixed point. Below or
         /// equal to every value, so `LOWEST.max_of(x)` is `x`, bit for bit.
         const LOWEST: Self;
-    }
-    impl Sealed for f32 {
-        const LOWEST: f32 = f32::NEG_INFINITY;
-    }
-    impl Sealed for super::I16F16 {
-        const LOWEST: Self = super::I16F16(i32::MIN);
+
+        /// Prepares a ray from an origin and a direction given in this mode.
+        fn ray_data(origin: [Self; 3], dir: [Self; 3]) -> Result<Self::RayData, RayError>;
+        /// Prepares a ray from an `f32` origin and direction (for fixed point, the direction keeps
+        /// more precision than a Q16.16 vector could carry).
+        fn ray_data_from_f32(origin: [f32; 3], dir: [f32; 3]) -> Result<Self::RayData, RayError>;
+        /// The same ray (direction bits unchanged) from another origin: motion blur moves rays
+        /// into a moving object's frame this way.
+        ///
+        /// # Errors
+        /// [`RayError::Origin`] for an unusable origin.
+        fn ray_moved(ray: &Self::RayData, origin: [Self; 3]) -> Result<Self::RayData, RayError>;
+        /// The ray from the same origin along another direction given in `f32`: the same bits as
+        /// `Numerics::ray_data_from_f32` with this ray's origin, without checking and preparing the
+        /// origin again.
+        ///
+        /// # Errors
+        /// [`RayError::ZeroDirection`] and [`RayError::NonFiniteDirection`].
+        fn ray_redirected_f32(
+            ray: &Self::RayData,
+            dir: [f32; 3],
+        ) -> Result<Self::RayData, RayError>;
+
+        /// Pads a node box outward by this mode's traversal error margin. Identity for fixed point.
+        fn pad_bounds(lo: [Self; 3], hi: [Self; 3]) -> ([Self; 3], [Self; 3]);
+        /// Conservative slab test. Returns the entry distance if the ray's interval `[t_min, t_max]`
+        /// overlaps the box, never culling a box that holds a primitive hit in that interval.
+        fn slab(
+            ray: &Self::RayData,
+            lo: &[Self; 3],
+            hi: &[Self; 3],
+            t_min: Self,
+            t_max: Self,
+        ) -> Option<Self>;
+        /// `Numerics::slab` of two boxes `(lo, hi)` at once (a BVH node's children), with the same
+        /// results: bit for bit the same entry distances.
+        #[inline(always)]
+        fn slab_pair(
+            ray: &Self::RayData,
+            a: (&[Self; 3], &[Self; 3]),
+            b: (&[Self; 3], &[Self; 3]),
+            t_min: Self,
+            t_max: Self,
+        ) -> [Option<Self>; 2] {
+            [
+                Self::slab(ray, a.0, a.1, t_min, t_max),
+                Self::slab(ray, b.0, b.1, t_min, t_max),
+            ]
+        }
+        /// `Numerics::slab` of four boxes at once (a 4-wide BVH node's children), given as
+        /// structure of arrays: `lo[axis][box]`, `hi[axis][box]`. Returns a mask (bit `i` set if box
+        /// `i` is accepted) and the entry distances; for every accepted box the distance has the
+        /// same bits as `slab` gives, and the accept/reject decisions are `slab`'s. Entries of
+        /// rejected boxes are unspecified.
+        ///
+        /// The default runs `slab` per box; `f32` computes the four boxes in the lanes of
+        /// one vector (`scalar/wide.rs`), with each lane doing `slab`'s operations in its order.
+        #[inline(always)]
+        fn slab4(
+            ray: &Self::RayData,
+            lo: &[[Self; 4]; 3],
+            hi: &[[Self; 4]; 3],
+            t_min: Self,
+            t_max: Self,
+        ) -> (u32, [Self; 4]) {
+            let mut mask = 0u32;
+            let mut t = [t_min; 4];
+            for (i, slot) in t.iter_mut().enumerate() {
+                let i = i.min(3); // a no-op that shows the compiler the bound
+                let l = [lo[0][i], lo[1][i], lo[2][i]];
+                let h = [hi[0][i], hi[1][i], hi[2][i]];
+                if let Some(near) = Self::slab(ray, &l, &h, t_min, t_max) {
+                    *slot = near;
+                    mask |= 1 << i;
+                }
+            }
+            (mask, t)
+        }
+        /// `t >= 0` widened by the slab test's margin: the test accepts boxes entered up to
+        /// `widen(t)`.
+        #[must_use]
+        fn widen(t: Self) -> Self;
+        /// The per-axis part of `Numerics::slab`, for traversals that walk cells plane by plane
+        /// (the uniform grid): `(entry, exit)` of the ray between the planes `lo <= hi` of `axis`,
+        /// the exit already widened.
+        ///
+        /// Contract (tested against `slab`): `slab(ray, lo, hi, t_min, t_max)` returns `Some(e)`
+        /// exactly when `e = max(t_min, entry_0, entry_1, entry_2) <= min(widen(t_max), exit_0,
+        /// exit_1, exit_2)`; in fixed point values beyond the range are clamped to it, which can
+        /// only add acceptances at the range end. An axis that constrains nothing (`f32`: a zero
+        /// direction component whose shifted origin lies on the `hi` plane) gives `(-inf, +inf)`.
+        /// Both ends are nondecreasing in `lo` and `hi` when `Numerics::axis_negative` is false and
+        /// nonincreasing when it is true (including zero direction components).
+        fn slab_axis(ray: &Self::RayData, axis: usize, lo: Self, hi: Self) -> (Self, Self);
+        /// True if the ray runs towards decreasing coordinates on `axis` as the slab test sees it
+        /// (in `f32` a `-0` component counts as negative: its reciprocal is `-inf`).
+        fn axis_negative(ray: &Self::RayData, axis: usize) -> bool;
+
+        /// Distance to a two-sided triangle if it is hit within `[t_min, t_max]`.
+        /// Degenerate triangles are never hit.
+        fn triangle_t(
+            ray: &Self::RayData,
+            v: &[[Self; 3]; 3],
+            t_min: Self,
+            t_max: Self,
+        ) -> Option<Self>;
+        /// Barycentrics `(u, v)` of the hit (weights of the second and third vertex). Only meaningful
+        /// for a triangle that `Numerics::triangle_t` reports as hit; zero otherwise.
+        fn triangle_uv(ray: &Self::RayData, v: &[[Self; 3]; 3]) -> (Self, Self);
+        /// Distance to a sphere surface if it is hit within `[t_min, t_max]` (nearest root first).
+        fn sphere_t(
+            ray: &Self::RayData,
+            center: &[Self; 3],
+            radius: Self,
+            t_min: Self,
+            t_max: Self,
+        ) -> Option<Self>;
+        /// `center - r` and `center + r` per axis, rounded outward.
+        fn sphere_bounds(center: &[Self; 3], radius: Self) -> ([Self; 3], [Self; 3]);
     }
 }
+
+/// The per-ray data of mode `S` that [`Primitive`](crate::Primitive) tests receive: read its
+/// origin and direction with [`Scalar::ray_origin`] and [`Scalar::ray_dir`].
+pub type RayData<S> = <S as sealed::Numerics>::RayData;
 
 /// The number type the kernel computes in. Implemented for `f32` and [`I16F16`] only.
 ///
@@ -39,12 +169,10 @@ mod sealed {
 /// platform. Only correctly rounded IEEE operations and `libm` are used in `f32` mode, min/max are
 /// explicit comparisons, and no NaN is ever returned.
 pub trait Scalar:
-    sealed::Sealed + Copy + PartialEq + PartialOrd + Debug + Default + Send + Sync + 'static
+    sealed::Numerics + Copy + PartialEq + PartialOrd + Debug + Default + Send + Sync + 'static
 {
     /// The vector type of the public API: `glam::Vec3` for `f32`, [`crate::Vec3x`] for fixed point.
     type Vec3: Copy + Debug;
-    /// Per-ray data precomputed once by [`crate::Ray`]'s constructors for the box and primitive tests.
-    type RayData: Copy + Debug + Send + Sync;
 
     /// Zero.
     const ZERO: Self;
@@ -88,123 +216,8 @@ pub trait Scalar:
         }
     }
 
-    /// Prepares a ray from an origin and a direction given in this mode.
-    fn ray_data(origin: [Self; 3], dir: [Self; 3]) -> Result<Self::RayData, RayError>;
-    /// Prepares a ray from an `f32` origin and direction (for fixed point, the direction keeps
-    /// more precision than a Q16.16 vector could carry).
-    fn ray_data_from_f32(origin: [f32; 3], dir: [f32; 3]) -> Result<Self::RayData, RayError>;
-    /// The same ray (direction bits unchanged) from another origin: motion blur moves rays
-    /// into a moving object's frame this way.
-    ///
-    /// # Errors
-    /// [`RayError::Origin`] for an unusable origin.
-    fn ray_moved(ray: &Self::RayData, origin: [Self; 3]) -> Result<Self::RayData, RayError>;
-    /// The ray from the same origin along another direction given in `f32`: the same bits as
-    /// [`Scalar::ray_data_from_f32`] with this ray's origin, without checking and preparing the
-    /// origin again.
-    ///
-    /// # Errors
-    /// [`RayError::ZeroDirection`] and [`RayError::NonFiniteDirection`].
-    fn ray_redirected_f32(ray: &Self::RayData, dir: [f32; 3]) -> Result<Self::RayData, RayError>;
     /// The ray origin.
     fn ray_origin(ray: &Self::RayData) -> [Self; 3];
     /// The (unit-length) ray direction, rounded to this mode.
     fn ray_dir(ray: &Self::RayData) -> [Self; 3];
-
-    /// Pads a node box outward by this mode's traversal error margin. Identity for fixed point.
-    fn pad_bounds(lo: [Self; 3], hi: [Self; 3]) -> ([Self; 3], [Self; 3]);
-    /// Conservative slab test. Returns the entry distance if the ray's interval `[t_min, t_max]`
-    /// overlaps the box, never culling a box that holds a primitive hit in that interval.
-    fn slab(
-        ray: &Self::RayData,
-        lo: &[Self; 3],
-        hi: &[Self; 3],
-        t_min: Self,
-        t_max: Self,
-    ) -> Option<Self>;
-    /// [`Scalar::slab`] of two boxes `(lo, hi)` at once (a BVH node's children), with the same
-    /// results: bit for bit the same entry distances.
-    #[inline(always)]
-    fn slab_pair(
-        ray: &Self::RayData,
-        a: (&[Self; 3], &[Self; 3]),
-        b: (&[Self; 3], &[Self; 3]),
-        t_min: Self,
-        t_max: Self,
-    ) -> [Option<Self>; 2] {
-        [
-            Self::slab(ray, a.0, a.1, t_min, t_max),
-            Self::slab(ray, b.0, b.1, t_min, t_max),
-        ]
-    }
-    /// [`Scalar::slab`] of four boxes at once (a 4-wide BVH node's children), given as
-    /// structure of arrays: `lo[axis][box]`, `hi[axis][box]`. Returns a mask (bit `i` set if box
-    /// `i` is accepted) and the entry distances; for every accepted box the distance has the
-    /// same bits as `slab` gives, and the accept/reject decisions are `slab`'s. Entries of
-    /// rejected boxes are unspecified.
-    ///
-    /// The default runs `slab` per box; `f32` computes the four boxes in the lanes of
-    /// one vector (`scalar/wide.rs`), with each lane doing `slab`'s operations in its order.
-    #[inline(always)]
-    fn slab4(
-        ray: &Self::RayData,
-        lo: &[[Self; 4]; 3],
-        hi: &[[Self; 4]; 3],
-        t_min: Self,
-        t_max: Self,
-    ) -> (u32, [Self; 4]) {
-        let mut mask = 0u32;
-        let mut t = [t_min; 4];
-        for (i, slot) in t.iter_mut().enumerate() {
-            let i = i.min(3); // a no-op that shows the compiler the bound
-            let l = [lo[0][i], lo[1][i], lo[2][i]];
-            let h = [hi[0][i], hi[1][i], hi[2][i]];
-            if let Some(near) = Self::slab(ray, &l, &h, t_min, t_max) {
-                *slot = near;
-                mask |= 1 << i;
-            }
-        }
-        (mask, t)
-    }
-    /// `t >= 0` widened by the slab test's margin: the test accepts boxes entered up to
-    /// `widen(t)`.
-    #[must_use]
-    fn widen(t: Self) -> Self;
-    /// The per-axis part of [`Scalar::slab`], for traversals that walk cells plane by plane
-    /// (the uniform grid): `(entry, exit)` of the ray between the planes `lo <= hi` of `axis`,
-    /// the exit already widened.
-    ///
-    /// Contract (tested against `slab`): `slab(ray, lo, hi, t_min, t_max)` returns `Some(e)`
-    /// exactly when `e = max(t_min, entry_0, entry_1, entry_2) <= min(widen(t_max), exit_0,
-    /// exit_1, exit_2)`; in fixed point values beyond the range are clamped to it, which can
-    /// only add acceptances at the range end. An axis that constrains nothing (`f32`: a zero
-    /// direction component whose shifted origin lies on the `hi` plane) gives `(-inf, +inf)`.
-    /// Both ends are nondecreasing in `lo` and `hi` when [`Scalar::axis_negative`] is false and
-    /// nonincreasing when it is true (including zero direction components).
-    fn slab_axis(ray: &Self::RayData, axis: usize, lo: Self, hi: Self) -> (Self, Self);
-    /// True if the ray runs towards decreasing coordinates on `axis` as the slab test sees it
-    /// (in `f32` a `-0` component counts as negative: its reciprocal is `-inf`).
-    fn axis_negative(ray: &Self::RayData, axis: usize) -> bool;
-
-    /// Distance to a two-sided triangle if it is hit within `[t_min, t_max]`.
-    /// Degenerate triangles are never hit.
-    fn triangle_t(
-        ray: &Self::RayData,
-        v: &[[Self; 3]; 3],
-        t_min: Self,
-        t_max: Self,
-    ) -> Option<Self>;
-    /// Barycentrics `(u, v)` of the hit (weights of the second and third vertex). Only meaningful
-    /// for a triangle that [`Scalar::triangle_t`] reports as hit; zero otherwise.
-    fn triangle_uv(ray: &Self::RayData, v: &[[Self; 3]; 3]) -> (Self, Self);
-    /// Distance to a sphere surface if it is hit within `[t_min, t_max]` (nearest root first).
-    fn sphere_t(
-        ray: &Self::RayData,
-        center: &[Self; 3],
-        radius: Self,
-        t_min: Self,
-        t_max: Self,
-    ) -> Option<Self>;
-    /// `center - r` and `center + r` per axis, rounded outward.
-    fn sphere_bounds(center: &[Self; 3], radius: Self) -> ([Self; 3], [Self; 3]);
 }

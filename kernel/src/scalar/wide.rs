@@ -1,7 +1,7 @@
 //! The `f32` slab test of four boxes at once, one box per lane of an [`F4`]: the box test of a
 //! 4-wide BVH node (`accel/bvh4`).
 //!
-//! Each lane performs exactly the operations of `Scalar::slab` for `f32` (`float.rs`) on its
+//! Each lane performs exactly the operations of `Numerics::slab` for `f32` (`float.rs`) on its
 //! box, in the same order: per axis `a = (lo - o_lo) * inv`, `b = (hi - o_hi) * inv`,
 //! `near = min(a, b)`, `far = max(a, b)` (SSE semantics: the second operand when unordered);
 //! then `t_near = max(near_z, max(near_y, max(near_x, t_min)))`, `t_far` likewise with `min`
@@ -11,7 +11,7 @@
 
 use super::lanes::F4;
 
-/// `Scalar::slab4` for `f32`: `o_lo`, `o_hi`, `inv` are the ray's shifted origins and
+/// `Numerics::slab4` for `f32`: `o_lo`, `o_hi`, `inv` are the ray's shifted origins and
 /// reciprocal direction (lanes x, y, z, z), `widen` the far-end factor; boxes in structure of
 /// arrays `lo[axis][box]`.
 #[allow(clippy::too_many_arguments)]

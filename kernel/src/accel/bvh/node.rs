@@ -5,7 +5,7 @@ use crate::scalar::Scalar;
 ///
 /// Invariant: `count == 0` marks an inner node whose children are `first` and `first + 1`
 /// (always after the node itself, `first` even); slot 1 of an arena is unused padding; otherwise a leaf covering `prim_ids[first..first + count]`.
-/// Bounds are padded outward by the mode's traversal margin ([`Scalar::pad_bounds`]).
+/// Bounds are padded outward by the mode's traversal margin (`Numerics::pad_bounds`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(32))]
 pub struct Node<S: Scalar> {

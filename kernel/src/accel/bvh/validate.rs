@@ -65,7 +65,7 @@ impl core::error::Error for InvalidTree {}
 impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
     /// Checks every invariant: children after and inside their parents, leaves tiling the id
     /// slice in order, every primitive exactly once, every leaf's box holding its primitives'
-    /// boxes padded by the traversal margin (the padded union [`Scalar::pad_bounds`] gives, as
+    /// boxes padded by the traversal margin (the padded union `Numerics::pad_bounds` gives, as
     /// the builder and refit compute it), depth within the cap and as recorded. One pass over
     /// the nodes after the id check; a tree that passes answers every query as brute force
     /// over its primitives does.

@@ -1,7 +1,7 @@
 //! A 4-wide BVH, collapsed from a built binary [`Bvh`], over caller-provided memory.
 //!
 //! Each [`Node4`] holds the boxes of up to four children side by side, so traversal tests
-//! them at once (`f32`: one vector lane per child, [`Scalar::slab4`]; fixed point: `slab`
+//! them at once (`f32`: one vector lane per child, `Numerics::slab4`; fixed point: `slab`
 //! per child) and visits the hit children nearest first. The collapse is the standard one
 //! (e.g. Wald et al. 2008, "Getting rid of packets"; Áfra et al. 2016 for the collapse order):
 //! a wide node starts from a BVH2 inner node's two children and repeatedly opens the inner

@@ -26,7 +26,7 @@ pub(crate) const EMPTY_SLOT: u32 = u32::MAX;
 ///
 /// Every node has at least two used slots, except a root whose only child is a leaf (a tree
 /// over one leaf). Boxes are the BVH2's node boxes, bit for bit (already padded by
-/// [`Scalar::pad_bounds`]).
+/// `Numerics::pad_bounds`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(128))]
 pub struct Node4<S: Scalar> {

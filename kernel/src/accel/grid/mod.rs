@@ -4,7 +4,7 @@
 //! **Layout.** The scene box (the union of every primitive's padded box) is cut into
 //! `res[0] × res[1] × res[2]` cells by planes `plane(axis, i)`, `i = 0..=res[axis]`, that are
 //! monotone in `i` and end exactly on the box. Each cell lists, in compressed-row form, the
-//! primitives whose *padded* box ([`Scalar::pad_bounds`]) overlaps it: `cells[c]..cells[c + 1]`
+//! primitives whose *padded* box (`Numerics::pad_bounds`) overlaps it: `cells[c]..cells[c + 1]`
 //! is cell `c`'s range in `refs`, ids ascending. A primitive's cells always cover its whole
 //! padded box (its first and last cell on each axis are found by comparing with the planes
 //! themselves, not by rounding a division).
@@ -22,7 +22,7 @@
 //! [`MAX_RES`].
 //!
 //! **Traversal** is a 3D-DDA that cannot miss a cell through rounding. Per axis, cell `i`'s
-//! interval of `t` comes from [`Scalar::slab_axis`] on its two planes, the very arithmetic of
+//! interval of `t` comes from `Numerics::slab_axis` on its two planes, the very arithmetic of
 //! the conservative slab test; these intervals are monotone along the ray and consecutive ones
 //! overlap. The walk keeps, per axis, the range of cells whose interval contains the current
 //! `t` and advances `t` to the next interval start on any axis (the classic `tMax` step); a

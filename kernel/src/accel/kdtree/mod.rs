@@ -1,7 +1,7 @@
 //! Kd-tree (axis-aligned binary space partition) over caller-provided memory.
 //!
 //! Each inner node cuts its box by one axis-aligned plane; a primitive goes to every child its
-//! *padded* box ([`Scalar::pad_bounds`]) reaches past the plane (a box ending exactly on the
+//! *padded* box (`Numerics::pad_bounds`) reaches past the plane (a box ending exactly on the
 //! plane stays on its side), so the leaves listing a primitive always cover its padded box.
 //! Splits are chosen by a binned surface area heuristic (32 candidate planes per axis, the
 //! primitives' padded boxes clipped to the node; cost `C_trav + C_isect · (1 - bonus) ·
