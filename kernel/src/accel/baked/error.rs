@@ -6,6 +6,7 @@ use core::fmt;
 /// Why [`super::read_header`], a loader or a writer refused. Every variant is a property of the
 /// bytes (or the buffer) alone: loading the same bytes again gives the same error.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum BakeError {
     /// Fewer bytes than the header (or, for a writer, the output buffer is too small).
     Truncated {

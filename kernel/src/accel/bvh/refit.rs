@@ -26,6 +26,7 @@ pub struct TreeShape {
 
 /// Why a refit refused.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum RefitError {
     /// A moved primitive is unusable (non-finite or out of range), as the builder checks.
     BadPrimitive {

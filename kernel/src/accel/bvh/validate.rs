@@ -20,6 +20,7 @@ pub struct TreeStats {
 
 /// The first violated invariant found by [`Bvh::validate`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum InvalidTree {
     /// An inner node's children are out of range or not after it.
     BadChild {

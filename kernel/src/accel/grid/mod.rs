@@ -268,6 +268,7 @@ pub struct GridStats {
 
 /// The first violated invariant found by [`Grid::validate`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum InvalidGrid {
     /// The offsets are not nondecreasing, do not start at 0 or do not end at the reference
     /// count.

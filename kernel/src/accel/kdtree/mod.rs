@@ -242,6 +242,7 @@ pub struct KdStats {
 
 /// The first violated invariant found by [`KdTree::validate`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum InvalidKdTree {
     /// An inner node's children are out of range or not after it.
     BadChild {
