@@ -3,9 +3,10 @@
 //! force, `occluded` vs `intersect`, wrong or missing typed errors, panics) per ray class, in
 //! both number modes, with a Möller–Trumbore contrast column (test-only code, not the kernel).
 //!
-//! `cargo test -p raykernel --test stress -- --nocapture` prints the Markdown table of
-//! docs/STRESS.md. The kernel columns must be zero; the Möller–Trumbore column is reported, not
-//! asserted. `STRESS_SPAWN=N` changes the spawned rays per mode (default 1 000 000).
+//! One test per ray class and mode (`watertight_f32`, `spawned_fixed`, ...), each failing unless
+//! the kernel's counts of its classes are zero. `cargo xtask stress` runs the ignored `table`
+//! test over the full matrix and writes the Markdown table of docs/STRESS.md.
+//! `STRESS_FULL=1` selects the full matrix, `STRESS_SPAWN=N` the spawned rays per mode.
 // MT keeps its textbook comparisons (NaN-safe as written).
 #![allow(clippy::manual_range_contains, clippy::type_complexity)]
 
@@ -23,9 +24,10 @@ use raykernel_testkit::icosphere::unit_icosphere;
 use raykernel_testkit::memory::OwnedMemory;
 use raykernel_testkit::vec3::{cross, dot, normalize, sub};
 use raykernel_testkit::Rng;
+use std::cell::RefCell;
 use std::collections::{BTreeMap, HashMap};
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::Mutex;
+use std::sync::OnceLock;
 
 const SEED: u64 = 0x5757_2e55_0006;
 
@@ -64,7 +66,29 @@ struct Table {
     informational: Vec<String>,
 }
 
-static TABLE: Mutex<Option<Table>> = Mutex::new(None);
+impl Table {
+    /// Adds `other`'s counts, failures and informational classes to this table's.
+    fn merge(&mut self, other: Table) {
+        for (key, cols) in other.rows {
+            let row = self.rows.entry(key).or_default();
+            for (col, c) in cols {
+                row.entry(col).or_default().add(c);
+            }
+        }
+        self.failures.extend(other.failures);
+        for class in other.informational {
+            if !self.informational.contains(&class) {
+                self.informational.push(class);
+            }
+        }
+    }
+}
+
+thread_local! {
+    /// The counts of the classes run on this thread: each test runs on its own thread, so each
+    /// test sees only what it ran.
+    static TABLE: RefCell<Table> = RefCell::new(Table::default());
+}
 
 /// Ordered row names (the number sorts the table).
 fn class_order(class: &str) -> usize {
@@ -89,8 +113,10 @@ fn class_order(class: &str) -> usize {
 }
 
 fn record(class: &str, column: &'static str, c: Count, failures: Vec<String>) {
-    let mut t = TABLE.lock().unwrap_or_else(|e| e.into_inner());
-    let t = t.get_or_insert_with(Table::default);
+    TABLE.with_borrow_mut(|t| record_in(t, class, column, c, failures));
+}
+
+fn record_in(t: &mut Table, class: &str, column: &'static str, c: Count, failures: Vec<String>) {
     t.rows
         .entry((class_order(class), class.to_string()))
         .or_default()
@@ -1547,6 +1573,7 @@ fn bad_input<S: Mode>() {
 
 // ---------------------------------------------------------------------------------------------
 
+/// Runs every class in mode `S` (the `table` test).
 fn run_mode<S: Mode>(meshes: &[Mesh]) {
     let t = std::time::Instant::now();
     let lap = |what: &str| println!("[{}] {what}: {:.1} s", S::COLUMN, t.elapsed().as_secs_f64());
@@ -1568,36 +1595,25 @@ fn full() -> bool {
     std::env::var("STRESS_FULL").is_ok_and(|v| v == "1")
 }
 
-#[test]
-fn stress_suite() {
-    let start = std::time::Instant::now();
-    let meshes = meshes();
-    std::thread::scope(|s| {
-        let a = s.spawn(|| run_mode::<f32>(&meshes));
-        let b = s.spawn(|| run_mode::<I16F16>(&meshes));
-        // Propagate panics from either mode.
-        let ra = a.join();
-        let rb = b.join();
-        if let Err(e) = ra.and(rb) {
-            std::panic::resume_unwind(e);
-        }
-    });
-    let t = TABLE.lock().unwrap_or_else(|e| e.into_inner());
-    let t = t.as_ref().expect("no results");
-    println!("{}", table_markdown(t));
-    println!(
-        "meshes: {}; stress suite took {:.1} s",
-        meshes
-            .iter()
-            .map(|m| format!("{} ({} tris)", m.name, m.faces.len()))
-            .collect::<Vec<_>>()
-            .join(", "),
-        start.elapsed().as_secs_f64()
-    );
-    // The kernel's columns must be zero in every asserted class; each class must have run.
+/// The meshes of the mesh-based classes, built (and the bunny read) once for every test.
+fn shared_meshes() -> &'static [Mesh] {
+    static MESHES: OnceLock<Vec<Mesh>> = OnceLock::new();
+    MESHES.get_or_init(meshes)
+}
+
+/// Runs `classes` on this thread's table, emptied first, and returns what they recorded.
+fn counted(classes: impl FnOnce()) -> Table {
+    TABLE.with_borrow_mut(|t| *t = Table::default());
+    classes();
+    TABLE.take()
+}
+
+/// Why `t` fails: in each of `columns`, an asserted class that did not run or has non-zero
+/// kernel counts. Empty if it passes.
+fn problems(t: &Table, columns: &[&str]) -> Vec<String> {
     let mut bad = Vec::new();
     for ((_, class), cols) in &t.rows {
-        for col in [F32, FIXED] {
+        for &col in columns {
             let Some(c) = cols.get(col) else {
                 bad.push(format!("{class}: no {col} results"));
                 continue;
@@ -1613,25 +1629,136 @@ fn stress_suite() {
             }
         }
     }
-    let spawned: u64 = ["spawned: reflection and hemisphere", "spawned: shadow rays"]
-        .iter()
-        .map(|c| {
-            t.rows
-                .iter()
-                .find(|(k, _)| k.1 == *c)
-                .map_or(0, |(_, v)| v.get(F32).map_or(0, |x| x.rays))
-        })
-        .sum();
-    if spawned < spawn_total() * 9 / 10 {
-        bad.push(format!(
-            "only {spawned} spawned rays in f32, want about {}",
-            spawn_total()
-        ));
-    }
+    bad
+}
+
+/// Runs `classes` in mode `S` and fails unless every class it recorded is clean in `S`'s column.
+fn check<S: Mode>(classes: impl FnOnce()) -> Table {
+    let t = counted(classes);
+    assert!(!t.rows.is_empty(), "no class recorded anything");
+    let bad = problems(&t, &[S::COLUMN]);
     assert!(
         bad.is_empty(),
         "{}\nfirst failures:\n{}",
         bad.join("\n"),
         t.failures.join("\n")
     );
+    t
 }
+
+/// Fails unless about [`spawn_total`] rays were spawned in `column` (reflection and shadow).
+fn assert_spawned_all(t: &Table, column: &str) {
+    let spawned: u64 = t
+        .rows
+        .iter()
+        .filter(|((_, class), _)| class.starts_with("spawned: "))
+        .map(|(_, cols)| cols.get(column).map_or(0, |c| c.rays))
+        .sum();
+    assert!(
+        spawned >= spawn_total() * 9 / 10,
+        "only {spawned} spawned rays in {column}, want about {}",
+        spawn_total()
+    );
+}
+
+#[test]
+fn watertight_f32() {
+    check::<f32>(|| watertight::<f32>(shared_meshes()));
+}
+
+#[test]
+fn watertight_fixed() {
+    check::<I16F16>(|| watertight::<I16F16>(shared_meshes()));
+}
+
+#[test]
+fn axis_parallel_f32() {
+    check::<f32>(axis_parallel::<f32>);
+}
+
+#[test]
+fn axis_parallel_fixed() {
+    check::<I16F16>(axis_parallel::<I16F16>);
+}
+
+#[test]
+fn box_rays_f32() {
+    check::<f32>(box_rays::<f32>);
+}
+
+#[test]
+fn box_rays_fixed() {
+    check::<I16F16>(box_rays::<I16F16>);
+}
+
+#[test]
+fn spawned_f32() {
+    let t = check::<f32>(|| spawned::<f32>(shared_meshes()));
+    assert_spawned_all(&t, F32);
+}
+
+#[test]
+fn spawned_fixed() {
+    let t = check::<I16F16>(|| spawned::<I16F16>(shared_meshes()));
+    assert_spawned_all(&t, FIXED);
+}
+
+#[test]
+fn degenerate_f32() {
+    check::<f32>(degenerate::<f32>);
+}
+
+#[test]
+fn degenerate_fixed() {
+    check::<I16F16>(degenerate::<I16F16>);
+}
+
+#[test]
+fn bad_input_f32() {
+    check::<f32>(bad_input::<f32>);
+}
+
+#[test]
+fn bad_input_fixed() {
+    check::<I16F16>(bad_input::<I16F16>);
+}
+
+/// Every class in both modes, printed as the Markdown table of docs/STRESS.md between marker
+/// lines (`cargo xtask stress` runs it with `STRESS_FULL=1` and writes the table).
+#[test]
+#[ignore = "the docs table: `cargo xtask stress`"]
+fn table() {
+    let start = std::time::Instant::now();
+    let meshes = shared_meshes();
+    let (f, x) = std::thread::scope(|s| {
+        let f = s.spawn(|| counted(|| run_mode::<f32>(meshes)));
+        let x = s.spawn(|| counted(|| run_mode::<I16F16>(meshes)));
+        (f.join(), x.join())
+    });
+    let (mut t, x) = match (f, x) {
+        (Ok(f), Ok(x)) => (f, x),
+        (Err(e), _) | (_, Err(e)) => std::panic::resume_unwind(e),
+    };
+    t.merge(x);
+    println!(
+        "{STRESS_TABLE_BEGIN}\n{}{STRESS_TABLE_END}",
+        table_markdown(&t)
+    );
+    println!(
+        "meshes: {}; stress suite took {:.1} s",
+        meshes
+            .iter()
+            .map(|m| format!("{} ({} tris)", m.name, m.faces.len()))
+            .collect::<Vec<_>>()
+            .join(", "),
+        start.elapsed().as_secs_f64()
+    );
+    let bad = problems(&t, &[F32, FIXED]);
+    assert!(bad.is_empty(), "{}", bad.join("\n"));
+    assert_spawned_all(&t, F32);
+    assert_spawned_all(&t, FIXED);
+}
+
+/// The lines around the table the `table` test prints (`cargo xtask stress` looks for them).
+const STRESS_TABLE_BEGIN: &str = "--- stress table ---";
+const STRESS_TABLE_END: &str = "--- end stress table ---";

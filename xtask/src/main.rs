@@ -16,6 +16,8 @@
 //!   (`determinism.rs`).
 //! - `cargo xtask speed`: instructions per ray and per pixel on the emulated cores; writes the
 //!   table of docs/PLATFORMS.md (`speed.rs`).
+//! - `cargo xtask stress`: the kernel's stress suite over the full matrix; writes the table of
+//!   docs/STRESS.md (`stress.rs`).
 //! - `cargo xtask bless`: rewrites the goldens: the hash file `tests/golden/kernel_hashes.txt`
 //!   (the kernel's golden test), then the snapshot PNGs `tests/golden/images/` (the host's
 //!   snapshot test, which also checks its renders against the new hashes).
@@ -28,6 +30,7 @@ mod determinism;
 mod platforms;
 mod size;
 mod speed;
+mod stress;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
@@ -83,10 +86,11 @@ fn main() -> ExitCode {
         Some("size") => size::size(),
         Some("determinism") => determinism::determinism(),
         Some("speed") => speed::speed(),
+        Some("stress") => stress::stress(),
         Some("bless") => bless(),
         _ => {
             eprintln!(
-                "usage: cargo xtask <qemu | panic-check | size | determinism | speed | bless>"
+                "usage: cargo xtask <qemu | panic-check | size | determinism | speed | stress | bless>"
             );
             false
         }

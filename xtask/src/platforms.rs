@@ -1,5 +1,5 @@
-//! The generated blocks of `docs/PLATFORMS.md` and the README: each sits between a begin and
-//! an end marker and is replaced whole by the command that owns it.
+//! The generated blocks of `docs/PLATFORMS.md`, `docs/STRESS.md` and the README: each sits
+//! between a begin and an end marker and is replaced whole by the command that owns it.
 
 use std::path::{Path, PathBuf};
 
@@ -7,12 +7,14 @@ use std::path::{Path, PathBuf};
 #[derive(Clone, Copy)]
 pub enum Doc {
     Platforms,
+    Stress,
     Readme,
 }
 
 fn doc_path(doc: Doc) -> PathBuf {
     let file = match doc {
         Doc::Platforms => "../docs/PLATFORMS.md",
+        Doc::Stress => "../docs/STRESS.md",
         Doc::Readme => "../README.md",
     };
     Path::new(env!("CARGO_MANIFEST_DIR")).join(file)
