@@ -66,10 +66,13 @@ fn triangle(c: &mut Criterion) {
 
 /// An icosphere of 20,480 triangles (radius 1) and 1024 rays from points inside it.
 fn scene() -> (Vec<Triangle<f32>>, Vec<Ray<f32>>) {
-    let (p, faces) = host::mesh::unit_icosphere(5);
+    let (p, faces) = raykernel_testkit::icosphere::unit_icosphere(5);
     let tris = faces
         .iter()
-        .map(|f| Triangle::from_f32(f.map(|i| p[i].map(|x| x as f32))).expect("vertices in range"))
+        .map(|f| {
+            Triangle::from_f32(f.map(|i| p[i as usize].map(|x| x as f32)))
+                .expect("vertices in range")
+        })
         .collect();
     let mut state = 0x2545_f491_4f6c_dd1du64;
     let mut unit = move || {

@@ -13,7 +13,6 @@
 //! run's ratio); `cargo bench -p raykernel-bench --bench render_overhead` measures the same
 //! fixtures with criterion.
 
-use host::mesh::unit_icosphere;
 use host::trace::NodeArena;
 use raykernel::bvh::{nodes_needed, BuildOptions};
 use raykernel::glam::Vec3;
@@ -69,9 +68,9 @@ impl Workload {
 
 /// The icosphere on its floor, in mode `S`.
 fn geometry<S: SpawnScalar>() -> Vec<Triangle<S>> {
-    let (verts, faces) = unit_icosphere(5);
-    let p = |i: usize| {
-        let v = verts[i];
+    let (verts, faces) = raykernel_testkit::icosphere::unit_icosphere(5);
+    let p = |i: u32| {
+        let v = verts[i as usize];
         [
             v[0] as f32 * 0.6,
             v[1] as f32 * 0.6 + 0.6,

@@ -17,7 +17,7 @@ fn temp_dir(name: &str) -> PathBuf {
 
 /// An icosphere of `20·4^levels` triangles around `center` as OBJ text.
 fn icosphere_obj(center: [f64; 3], levels: u32) -> String {
-    let (unit, triangles) = host::mesh::unit_icosphere(levels);
+    let (unit, triangles) = raykernel_testkit::icosphere::unit_icosphere(levels);
     let mut s = String::from("# icosphere\n");
     for v in unit {
         let p: [f32; 3] = std::array::from_fn(|k| (center[k] + v[k]) as f32);

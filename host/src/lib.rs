@@ -34,7 +34,6 @@ pub mod exr;
 pub mod gltf;
 pub mod input;
 pub mod limits;
-pub mod mesh;
 pub mod mtl;
 pub mod obj;
 pub mod output;

@@ -8,11 +8,11 @@ mod common;
 use common::{random_rays, temp_dir, Rng};
 use host::bake::{run_bake, run_trace_baked, BakeAccel, BakeArgs, TraceBakedArgs};
 use host::cli::{run_trace, TraceArgs};
-use host::mesh::unit_icosphere;
 use host::rayfile::write_rays;
 use host::trace::{Builder, Mode};
 use raykernel::bvh::DEFAULT_LEAF_SIZE;
 use raykernel::AccelKind;
+use raykernel_testkit::icosphere::unit_icosphere;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

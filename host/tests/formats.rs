@@ -184,7 +184,7 @@ fn faces_before_the_first_usemtl_are_white_and_bad_references_name_their_line() 
 /// An icosphere of `levels` subdivisions as OBJ text, with its unit positions as `vn` normals
 /// when `normals`.
 fn icosphere_obj(levels: u32, normals: bool) -> String {
-    let (positions, faces) = host::mesh::unit_icosphere(levels);
+    let (positions, faces) = raykernel_testkit::icosphere::unit_icosphere(levels);
     let mut text = String::new();
     for p in &positions {
         text.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2]));

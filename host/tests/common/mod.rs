@@ -22,7 +22,8 @@ pub struct Sphere {
 }
 
 pub fn icosphere(center: [f64; 3], radius: f64, levels: u32) -> Sphere {
-    let (unit, triangles) = host::mesh::unit_icosphere(levels);
+    let (unit, triangles) = raykernel_testkit::icosphere::unit_icosphere(levels);
+    let triangles = triangles.iter().map(|t| t.map(|i| i as usize)).collect();
     let positions = unit
         .iter()
         .map(|v| std::array::from_fn(|k| center[k] + radius * v[k]))
