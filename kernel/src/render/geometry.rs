@@ -14,7 +14,7 @@ use super::objects::{ObjectGeom, ObjectSlot, ShapeAccel};
 use super::scene::{Item, Light, Material, Object, Problem, Shape};
 use super::surface::{Prim, SurfacePoint};
 use super::SceneError;
-use crate::accel::bvh::{BuildOptions, Bvh};
+use crate::accel::bvh::Bvh;
 use crate::accel::{take, AccelFamily, BuildError, Counters, MemoryNeeded};
 use crate::geom::spawn::{cross, sub, unit, SpawnScalar};
 use crate::geom::{closer, Aabb, Primitive, Ray, Sphere};
@@ -147,7 +147,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
             let need = MemoryNeeded::bvh(slots.len());
             let nodes = take(&mut memory.nodes, need.nodes);
             let ids = take(&mut memory.words, need.words);
-            let tree = Bvh::build(slots, nodes, ids, BuildOptions::DEFAULT)
+            let tree = Bvh::build(slots, nodes, ids, F::TopLevel::default())
                 .map_err(|e| err(0, "objects", Problem::Build(e)))?;
             Some(tree)
         } else {

@@ -11,7 +11,7 @@
 use core::hint::black_box;
 use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m_rt::entry;
-use raykernel::bvh::{nodes_needed, BuildOptions};
+use raykernel::bvh::{nodes_needed, Sah, StaticBuild};
 use raykernel::render::scenes::{self, SceneData};
 use raykernel::render::{Object, ObjectSlot, RenderMemory, Renderer, Shape, Tile};
 use raykernel::{AccelMemory, BvhFamily, Node, Sphere, Triangle};
@@ -30,7 +30,10 @@ const NO_SPHERE: Sphere<f32> = Sphere {
     radius: 0.0,
 };
 const NO_OBJECT: Object<'static, f32> = Object::new(Shape::Triangles(&[]), 0);
-type Slot = ObjectSlot<'static, f32, BvhFamily>;
+/// SAH BVHs without the reinsertion pass, named at compile time: no other split rule or pass
+/// is linked.
+type Family = BvhFamily<StaticBuild<Sah, false>>;
+type Slot = ObjectSlot<'static, f32, Family>;
 
 /// Set to `DONE` when the row has been rendered; `cargo xtask size` polls it (in .bss).
 #[no_mangle]
@@ -63,7 +66,7 @@ fn render_row(data: &SceneData<'static>) -> Option<()> {
     let r = Renderer::new(
         &scene,
         data.settings,
-        black_box(BuildOptions::default()),
+        black_box(StaticBuild::<Sah, false>::default()),
         memory,
     )
     .ok()?;
