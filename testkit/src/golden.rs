@@ -11,8 +11,8 @@ pub use crate::Rng;
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::render::scenes::{self, ObjectData, SceneData, ShapeRange, SphereData};
 use raykernel::render::{
-    Camera, Filter, Integrator, Material, Object, ObjectSlot, Problem, RenderMemory, Renderer,
-    SamplerKind, Settings, Shape, Tile,
+    AllFeatures, Camera, Filter, Integrator, Material, Object, ObjectSlot, Problem, RenderFeatures,
+    RenderMemory, Renderer, SamplerKind, Settings, Shape, Tile,
 };
 use raykernel::spawn::SpawnScalar;
 use raykernel::{
@@ -489,13 +489,14 @@ const RENDER_WIDTH: usize = 64;
 /// same value as FNV-1a over the whole image's bytes.
 #[inline(never)] // one case's buffers on the stack at a time (the M0 has 16 KB of RAM)
 pub fn render_hash<S: Bits + SpawnScalar>(data: &SceneData<'_>) -> Result<u64, Fail> {
-    render_hash_with::<S, BvhFamily>(data, BuildOptions::default())
+    render_hash_with::<S, BvhFamily, AllFeatures>(data, BuildOptions::default())
 }
 
 /// As [`render_hash`], each object's BVH (and the objects' top-level BVH) built by family `F`
-/// with `options`: every family gives the same bytes.
+/// with `options`, by a renderer linking the parts `K` names: every family gives the same
+/// bytes, and so does every `K` that links what the scene needs (else [`Fail::NotLinked`]).
 #[inline(never)]
-pub fn render_hash_with<S: Bits + SpawnScalar, F: AccelFamily<S>>(
+pub fn render_hash_with<S: Bits + SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
     data: &SceneData<'_>,
     options: F::Options,
 ) -> Result<u64, Fail> {
@@ -527,13 +528,15 @@ pub fn render_hash_with<S: Bits + SpawnScalar, F: AccelFamily<S>>(
             ..AccelMemory::default()
         },
     };
-    let r = Renderer::new(&scene, data.settings, options, memory).map_err(|e| {
-        if e.problem == Problem::NotLinked {
-            Fail::NotLinked
-        } else {
-            Fail::Rejected { index: 0 }
-        }
-    })?;
+    let r = Renderer::<S, F, K>::with_features(&scene, data.settings, options, memory).map_err(
+        |e| {
+            if e.problem == Problem::NotLinked {
+                Fail::NotLinked
+            } else {
+                Fail::Rejected { index: 0 }
+            }
+        },
+    )?;
     let width = data.settings.width as usize;
     let mut row = [0u8; 3 * RENDER_WIDTH];
     let row = row

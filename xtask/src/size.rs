@@ -36,7 +36,7 @@ const PROBES: [Probe; 3] = [
     Probe {
         name: "render_bvh",
         bin: "size_probe_render",
-        what: "the default scene in f32, a BVH per object: scene conversion, `Renderer::new`, one row of sRGB pixels (the scene's buffers in statics, `.bss`)",
+        what: "the default scene in f32, a SAH BVH per object without reinsertion (`BvhFamily<StaticBuild<Sah, false>>`), the renderer's parts the scene uses (`RenderFeatures`): scene conversion, `Renderer::with_features`, one row of sRGB pixels (the scene's buffers in statics, `.bss`)",
     },
     Probe {
         name: "traverse_baked",

@@ -7,6 +7,7 @@
 //!
 //! Motion is in [`super::motion`]; leaving a surface in [`super::surface`].
 
+use super::features::RenderFeatures;
 use super::lights::{light_geom, LightGeom, MAX_LIGHTS};
 use super::memory::{memory_needed, RenderMemory};
 use super::motion::{displacement, moved_into_frame, swept_box};
@@ -64,7 +65,7 @@ pub(crate) struct Geometry<'a, S: Scalar, F: AccelFamily<S>> {
 
 impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     /// Builds every object's accelerator into the caller's memory ([`memory_needed`]).
-    pub(crate) fn build(
+    pub(crate) fn build<K: RenderFeatures>(
         objects: &'a [Object<'a, S>],
         materials: &[Material],
         lights: &[Light],
@@ -162,7 +163,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
         };
         for (i, l) in lights.iter().enumerate() {
             let _ = geo.lights.push(
-                light_geom(l)
+                light_geom::<S, K>(l)
                     .map_err(|(field, problem)| SceneError::new(Item::Light, i, field, problem))?,
             );
         }

@@ -1,9 +1,10 @@
-//! Size probe of the renderer: the default built-in scene (`f32`, the BVH family: one BVH per
-//! object, no other structure linked) converted
-//! into caller buffers, `Renderer::new`, and one row rendered to sRGB bytes; nothing else (no
-//! defmt, a spinning panic handler). `cargo xtask size` reports its `.text`/`.rodata`/`.bss` next
-//! to the build + traverse probe (`size_probe.rs`) and runs it under QEMU to measure its stack:
-//! the only measuring code is the store to [`PROBE_DONE`]. The scene's buffers are statics (in
+//! Size probe of the renderer: the default built-in scene (`f32`, the BVH family: one SAH BVH
+//! per object, no other structure, split rule or pass linked; the renderer's parts the scene
+//! uses, named at compile time) converted into caller buffers, `Renderer::with_features`, and
+//! one row rendered to sRGB bytes; nothing else (no defmt, a spinning panic handler).
+//! `cargo xtask size` reports its `.text`/`.rodata`/`.bss` next to the build + traverse probe
+//! (`size_probe.rs`) and runs it under QEMU to measure its stack: the only measuring code is
+//! the store to [`PROBE_DONE`]. The scene's buffers are statics (in
 //! `.bss`, as firmware keeps them), so the stack measured is the renderer's own.
 #![no_std]
 #![no_main]
@@ -13,7 +14,9 @@ use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m_rt::entry;
 use raykernel::bvh::{nodes_needed, Sah, StaticBuild};
 use raykernel::render::scenes::{self, SceneData};
-use raykernel::render::{Object, ObjectSlot, RenderMemory, Renderer, Shape, Tile};
+use raykernel::render::{
+    Object, ObjectSlot, RenderFeatures, RenderMemory, Renderer, Shape, Tile,
+};
 use raykernel::{AccelMemory, BvhFamily, Node, Sphere, Triangle};
 
 const TRIS: usize = 24;
@@ -34,6 +37,20 @@ const NO_OBJECT: Object<'static, f32> = Object::new(Shape::Triangles(&[]), 0);
 /// is linked.
 type Family = BvhFamily<StaticBuild<Sah, false>>;
 type Slot = ObjectSlot<'static, f32, Family>;
+
+/// The parts of the renderer the default scene uses: a rectangle light, two-sided surfaces
+/// that do not emit, the box filter, several samples per pixel.
+#[derive(Clone, Copy, Debug)]
+struct SceneFeatures;
+
+impl RenderFeatures for SceneFeatures {
+    const FILTERS: bool = false;
+    const POINT_LIGHTS: bool = false;
+    const SPHERE_LIGHTS: bool = false;
+    const EMISSIVE_GEOMETRY: bool = false;
+    const ONE_SIDED: bool = false;
+    const FIRST_HIT_LOOP: bool = false;
+}
 
 /// Set to `DONE` when the row has been rendered; `cargo xtask size` polls it (in .bss).
 #[no_mangle]
@@ -63,7 +80,7 @@ fn render_row(data: &SceneData<'static>) -> Option<()> {
             ..AccelMemory::default()
         },
     };
-    let r = Renderer::new(
+    let r = Renderer::<f32, Family, SceneFeatures>::with_features(
         &scene,
         data.settings,
         black_box(StaticBuild::<Sah, false>::default()),
