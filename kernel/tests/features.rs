@@ -60,7 +60,7 @@ fn path_integrator_is_a_typed_error_without_the_feature() {
     eprintln!("skipped tests/path.rs: the path integrator needs `--features path-tracing`");
 }
 
-/// Links the parts of the renderer named by the six flags, in `RenderFeatures` order.
+/// Links the parts of the renderer named by the seven flags, in `RenderFeatures` order.
 #[derive(Clone, Copy, Debug)]
 struct Only<const BITS: u8>;
 
@@ -70,7 +70,8 @@ impl<const BITS: u8> RenderFeatures for Only<BITS> {
     const SPHERE_LIGHTS: bool = BITS & 4 != 0;
     const EMISSIVE_GEOMETRY: bool = BITS & 8 != 0;
     const ONE_SIDED: bool = BITS & 16 != 0;
-    const FIRST_HIT_LOOP: bool = BITS & 32 != 0;
+    const SMOOTH_SHADING: bool = BITS & 32 != 0;
+    const FIRST_HIT_LOOP: bool = BITS & 64 != 0;
 }
 
 /// The core alone.
@@ -93,7 +94,8 @@ fn same_bytes_or_refused(data: &SceneData<'_>, needs: u8) {
         (8, hash::<Only<8>>(data)),
         (16, hash::<Only<16>>(data)),
         (32, hash::<Only<32>>(data)),
-        (needs, hash::<Only<63>>(data)),
+        (64, hash::<Only<64>>(data)),
+        (needs, hash::<Only<127>>(data)),
     ];
     for (bits, got) in results {
         if bits & needs == needs {
@@ -117,6 +119,13 @@ fn fewer_parts_render_the_same_bytes_or_refuse_the_scene() {
     same_bytes_or_refused(&scenes::SPHERES, 1 | 2);
     // Emitting, one-sided objects.
     same_bytes_or_refused(&golden::EMITTERS, 8 | 16);
+    // Vertex normals on every triangle.
+    const UP: [[[f32; 3]; 3]; 20] = [[[0.0, 1.0, 0.0]; 3]; 20];
+    let smooth = SceneData {
+        vertex_normals: &UP,
+        ..scenes::CORNELL
+    };
+    same_bytes_or_refused(&smooth, 32);
     // One sample at each pixel centre of a pinhole with nothing lit: the first-hit loop's
     // plan, which the general loop renders to the same bytes without it.
     let first_hit = SceneData {

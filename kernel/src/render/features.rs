@@ -20,6 +20,8 @@ pub trait RenderFeatures: Copy + Debug + 'static {
     const EMISSIVE_GEOMETRY: bool;
     /// One-sided objects ([`crate::render::Object::one_sided`]).
     const ONE_SIDED: bool;
+    /// Smooth shading by vertex normals ([`crate::render::Object::vertex_normals`]).
+    const SMOOTH_SHADING: bool;
     /// The first-hit loop for plans of camera rays only
     /// ([`crate::render::RenderPlan::camera_rays_only`]). A speed-up, not a feature: without it
     /// those scenes render through the general loop, to the same bits.
@@ -36,5 +38,6 @@ impl RenderFeatures for AllFeatures {
     const SPHERE_LIGHTS: bool = true;
     const EMISSIVE_GEOMETRY: bool = true;
     const ONE_SIDED: bool = true;
+    const SMOOTH_SHADING: bool = true;
     const FIRST_HIT_LOOP: bool = true;
 }

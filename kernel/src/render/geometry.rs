@@ -328,7 +328,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     /// ray), and what [`SurfacePoint::spawn_origin`] needs to leave it. `None` for lights.
     /// Inlined on hosted targets into both integrators (see `lighting::visible`).
     #[cfg_attr(not(target_os = "none"), inline(always))]
-    pub(crate) fn surface_point(
+    pub(crate) fn surface_point<K: RenderFeatures>(
         &self,
         ray: &Ray<S>,
         h: &SceneHit<S>,
@@ -356,6 +356,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
                 let shading = o
                     .vertex_normals
                     .get(local as usize)
+                    .filter(|_| K::SMOOTH_SHADING)
                     .and_then(|corners| interpolated_normal(corners, u, w, &n))
                     .unwrap_or(n);
                 Some(SurfacePoint {

@@ -73,7 +73,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatur
             }
             Some(m) => m,
         };
-        let Some(sp) = r.geometry.surface_point(ray, &hit, time) else {
+        let Some(sp) = r.geometry.surface_point::<K>(ray, &hit, time) else {
             break;
         };
         let dir_unit = unit_at(dir, depth);

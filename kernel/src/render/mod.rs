@@ -600,6 +600,8 @@ fn check_linked<S: SpawnScalar, K: RenderFeatures>(
     for (i, o) in scene.objects.iter().enumerate() {
         let field = if !K::ONE_SIDED && o.one_sided {
             "one_sided"
+        } else if !K::SMOOTH_SHADING && !o.vertex_normals.is_empty() {
+            "vertex_normals"
         } else if K::EMISSIVE_GEOMETRY || o.shape.is_empty() {
             continue;
         } else if o.emission != [0.0; 3] {

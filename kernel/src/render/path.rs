@@ -122,7 +122,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatur
         if segments >= max_length {
             break;
         }
-        let Some(sp) = r.geometry.surface_point(ray, &hit, time) else {
+        let Some(sp) = r.geometry.surface_point::<K>(ray, &hit, time) else {
             break;
         };
         // Two-sided surfaces: shade with the normals facing the incoming ray.

@@ -39,7 +39,7 @@ type Family = BvhFamily<StaticBuild<Sah, false>>;
 type Slot = ObjectSlot<'static, f32, Family>;
 
 /// The parts of the renderer the default scene uses: a rectangle light, two-sided surfaces
-/// that do not emit, the box filter, several samples per pixel.
+/// that do not emit, flat shading, the box filter, several samples per pixel.
 #[derive(Clone, Copy, Debug)]
 struct SceneFeatures;
 
@@ -49,6 +49,7 @@ impl RenderFeatures for SceneFeatures {
     const SPHERE_LIGHTS: bool = false;
     const EMISSIVE_GEOMETRY: bool = false;
     const ONE_SIDED: bool = false;
+    const SMOOTH_SHADING: bool = false;
     const FIRST_HIT_LOOP: bool = false;
 }
 
