@@ -59,35 +59,53 @@ static PROBE_DONE: AtomicU32 = AtomicU32::new(0);
 /// "DONE", as `xtask/src/size.rs` expects.
 const DONE: u32 = 0x444f_4e45;
 
+/// The scene's buffers, in statics.
+struct Buffers {
+    tris: &'static mut [Triangle<f32>; TRIS],
+    spheres: &'static mut [Sphere<f32>; SPHERES],
+    objects: &'static mut [Object<'static, f32>; OBJECTS],
+    slots: &'static mut [Slot; OBJECTS],
+    nodes: &'static mut [Node<f32>; NODES],
+    ids: &'static mut [u32; WORDS],
+}
+
+/// Takes the statics, once. Not inlined: their initial values pass through this function's
+/// frame, which is gone before the renderer runs, as in firmware that sets them up at boot.
 #[inline(never)]
-fn render_row(data: &SceneData<'static>) -> Option<()> {
-    let tris = cortex_m::singleton!(: [Triangle<f32>; TRIS] = [NO_TRIANGLE; TRIS])?;
-    let spheres = cortex_m::singleton!(: [Sphere<f32>; SPHERES] = [NO_SPHERE; SPHERES])?;
-    let tris = tris.get_mut(..data.triangles.len())?;
-    let spheres = spheres.get_mut(..data.spheres.len())?;
+fn buffers() -> Option<Buffers> {
+    Some(Buffers {
+        tris: cortex_m::singleton!(: [Triangle<f32>; TRIS] = [NO_TRIANGLE; TRIS])?,
+        spheres: cortex_m::singleton!(: [Sphere<f32>; SPHERES] = [NO_SPHERE; SPHERES])?,
+        objects: cortex_m::singleton!(: [Object<'static, f32>; OBJECTS] = [NO_OBJECT; OBJECTS])?,
+        slots: cortex_m::singleton!(: [Slot; OBJECTS] = [Slot::EMPTY; OBJECTS])?,
+        nodes: cortex_m::singleton!(: [Node<f32>; NODES] = [Node::EMPTY; NODES])?,
+        ids: cortex_m::singleton!(: [u32; WORDS] = [0; WORDS])?,
+    })
+}
+
+#[inline(never)]
+fn render_row(data: &SceneData<'static>, b: Buffers) -> Option<()> {
+    let tris = b.tris.get_mut(..data.triangles.len())?;
+    let spheres = b.spheres.get_mut(..data.spheres.len())?;
     data.triangles_into(tris).ok()?;
     data.spheres_into(spheres).ok()?;
-    let objects = cortex_m::singleton!(: [Object<'static, f32>; OBJECTS] = [NO_OBJECT; OBJECTS])?;
-    let scene = data.scene(tris, spheres, objects).ok()?;
-    // The BVH family: no other structure is linked.
-    let slots = cortex_m::singleton!(: [Slot; OBJECTS] = [Slot::EMPTY; OBJECTS])?;
-    let nodes = cortex_m::singleton!(: [Node<f32>; NODES] = [Node::EMPTY; NODES])?;
-    let ids = cortex_m::singleton!(: [u32; WORDS] = [0; WORDS])?;
+    let scene = data.scene(tris, spheres, b.objects).ok()?;
     let memory = RenderMemory {
-        objects: slots,
+        objects: b.slots,
         accel: AccelMemory {
-            nodes,
-            words: ids,
+            nodes: b.nodes,
+            words: b.ids,
             ..AccelMemory::default()
         },
     };
-    let r = Renderer::<f32, Family, SceneFeatures>::with_features(
+    let Ok(r) = Renderer::<f32, Family, SceneFeatures>::with_features(
         &scene,
         data.settings,
         black_box(StaticBuild::<Sah, false>::default()),
         memory,
-    )
-    .ok()?;
+    ) else {
+        return None;
+    };
     let mut row = [0u8; 3 * WIDTH];
     let tile = Tile {
         x: 0,
@@ -102,7 +120,9 @@ fn render_row(data: &SceneData<'static>) -> Option<()> {
 
 #[entry]
 fn main() -> ! {
-    black_box(render_row(black_box(&scenes::CORNELL)));
+    if let Some(b) = buffers() {
+        black_box(render_row(black_box(&scenes::CORNELL), b));
+    }
     PROBE_DONE.store(DONE, Ordering::Relaxed);
     loop {
         cortex_m::asm::wfi();
