@@ -157,3 +157,30 @@ fn static_settings_refuse_bad_leaf_sizes_as_the_run_time_ones() {
         assert!(want.is_some() && got == want, "leaf {leaf}: {got:?}");
     }
 }
+
+/// A renderer whose BVH family names its settings at compile time renders every built-in scene
+/// to the bytes of the run-time default, in both modes.
+#[test]
+fn static_family_renders_the_default_bytes() {
+    use raykernel::render::{scenes, AllFeatures};
+    use raykernel::BvhFamily;
+    use raykernel_testkit::golden::{render_hash, render_hash_with, Bits, EMITTERS};
+
+    fn check<S: Bits + raykernel::spawn::SpawnScalar>() {
+        for data in [scenes::CORNELL, scenes::SPHERES, scenes::MOTION, EMITTERS] {
+            let want = render_hash::<S>(&data).unwrap();
+            let got = render_hash_with::<S, BvhFamily<StaticBuild<Sah, false>>, AllFeatures>(
+                &data,
+                StaticBuild::default(),
+            );
+            assert_eq!(got.unwrap(), want, "{}", data.name);
+            let got = render_hash_with::<S, BvhFamily<StaticBuild<Median, true>>, AllFeatures>(
+                &data,
+                StaticBuild::new(1),
+            );
+            assert_eq!(got.unwrap(), want, "{}", data.name);
+        }
+    }
+    check::<f32>();
+    check::<I16F16>();
+}

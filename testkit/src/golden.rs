@@ -11,13 +11,13 @@ pub use crate::Rng;
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::render::scenes::{self, ObjectData, SceneData, ShapeRange, SphereData};
 use raykernel::render::{
-    Camera, Filter, Integrator, Material, Object, ObjectSlot, Problem, RenderMemory, Renderer,
-    SamplerKind, Settings, Shape, Tile,
+    AllFeatures, Camera, Filter, Integrator, Material, Object, ObjectSlot, Problem, RenderFeatures,
+    RenderMemory, Renderer, SamplerKind, Settings, Shape, Tile,
 };
 use raykernel::spawn::SpawnScalar;
 use raykernel::{
-    Accel, AccelMemory, Bvh, BvhFamily, Hit, Linear, Node, Primitive, Ray, Scalar, Sphere,
-    Triangle, I16F16,
+    Accel, AccelFamily, AccelMemory, Bvh, BvhFamily, Hit, Linear, Node, Primitive, Ray, Scalar,
+    Sphere, Triangle, I16F16,
 };
 
 /// Triangles of the level-1 icosphere.
@@ -489,6 +489,17 @@ const RENDER_WIDTH: usize = 64;
 /// same value as FNV-1a over the whole image's bytes.
 #[inline(never)] // one case's buffers on the stack at a time (the M0 has 16 KB of RAM)
 pub fn render_hash<S: Bits + SpawnScalar>(data: &SceneData<'_>) -> Result<u64, Fail> {
+    render_hash_with::<S, BvhFamily, AllFeatures>(data, BuildOptions::default())
+}
+
+/// As [`render_hash`], each object's BVH (and the objects' top-level BVH) built by family `F`
+/// with `options`, by a renderer linking the parts `K` names: every family gives the same
+/// bytes, and so does every `K` that links what the scene needs (else [`Fail::NotLinked`]).
+#[inline(never)]
+pub fn render_hash_with<S: Bits + SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    data: &SceneData<'_>,
+    options: F::Options,
+) -> Result<u64, Fail> {
     let reject = |_| Fail::Rejected { index: 0 };
     let mut tris = [Triangle::<S> {
         v: [[S::ZERO; 3]; 3],
@@ -508,8 +519,7 @@ pub fn render_hash<S: Bits + SpawnScalar>(data: &SceneData<'_>) -> Result<u64, F
     let mut nodes = [Node::<S>::EMPTY;
         nodes_needed(RENDER_TRIS) + nodes_needed(RENDER_SPHERES) + 4 * RENDER_OBJECTS];
     let mut ids = [0u32; RENDER_TRIS + RENDER_SPHERES + RENDER_OBJECTS];
-    // The BVH family alone: the other structures are not linked into the on-target tests.
-    let mut slots = [ObjectSlot::<S, BvhFamily>::EMPTY; RENDER_OBJECTS];
+    let mut slots = [ObjectSlot::<S, F>::EMPTY; RENDER_OBJECTS];
     let memory = RenderMemory {
         objects: &mut slots,
         accel: AccelMemory {
@@ -518,13 +528,15 @@ pub fn render_hash<S: Bits + SpawnScalar>(data: &SceneData<'_>) -> Result<u64, F
             ..AccelMemory::default()
         },
     };
-    let r = Renderer::new(&scene, data.settings, BuildOptions::default(), memory).map_err(|e| {
-        if e.problem == Problem::NotLinked {
-            Fail::NotLinked
-        } else {
-            Fail::Rejected { index: 0 }
-        }
-    })?;
+    let r = Renderer::<S, F, K>::with_features(&scene, data.settings, options, memory).map_err(
+        |e| {
+            if e.problem == Problem::NotLinked {
+                Fail::NotLinked
+            } else {
+                Fail::Rejected { index: 0 }
+            }
+        },
+    )?;
     let width = data.settings.width as usize;
     let mut row = [0u8; 3 * RENDER_WIDTH];
     let row = row

@@ -8,14 +8,13 @@ use std::path::PathBuf;
 
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").expect("OUT_DIR"));
-    // memory.x.in says 16 KB of RAM; the M0 (QEMU's micro:bit run with the 32 KB of SRAM of the
-    // nRF51822-QFAC, see .cargo/config.toml) gets 32 KB, the LM3S6965 and the MPS2 64 KB: a
-    // render needs about 16 KB of stack.
+    // memory.x.in says 16 KB of RAM, the micro:bit's own (the M0, QEMU's micro:bit machine);
+    // the LM3S6965 and the MPS2 get 64 KB.
     let memory = fs::read_to_string("memory.x.in").expect("read memory.x.in");
     let memory = if env::var("TARGET").is_ok_and(|t| t != "thumbv6m-none-eabi") {
         memory.replace("LENGTH = 16K", "LENGTH = 64K")
     } else {
-        memory.replace("LENGTH = 16K", "LENGTH = 32K")
+        memory
     };
     fs::write(out.join("memory.x"), memory).expect("write memory.x");
     println!("cargo:rustc-link-search={}", out.display());

@@ -366,6 +366,6 @@ fn machine_how(core: &str) -> &'static str {
     match core {
         "Cortex-M4F" => "qemu-system-arm `mps2-an386`, defmt-test",
         "Cortex-M3" => "qemu-system-arm `lm3s6965evb`, defmt-test",
-        _ => "qemu-system-arm `microbit` (32 KB), defmt-test",
+        _ => "qemu-system-arm `microbit` (16 KB), defmt-test",
     }
 }

@@ -36,8 +36,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
 
 /// Target, core, QEMU machine and CPU. The M0 runs on QEMU's micro:bit machine (nRF51822) with
-/// 32 KB of SRAM, the nRF51822's QFAC part, as [`M0_RAM`] sets (a render's stack does not fit
-/// the 16 KB of the micro:bit's own QFAA part).
+/// the micro:bit's own 16 KB of SRAM.
 const TARGETS: [(&str, &str, &str, &str); 3] = [
     (
         "thumbv7em-none-eabihf",
@@ -53,19 +52,6 @@ const TARGETS: [(&str, &str, &str, &str); 3] = [
     ),
     ("thumbv6m-none-eabi", "Cortex-M0", "microbit", "cortex-m0"),
 ];
-
-/// QEMU option giving the M0's nRF51 32 KB of SRAM; `tests/qemu/.cargo/config.toml` passes the
-/// same to the test runner, and `tests/qemu/build.rs` links for it.
-const M0_RAM: &str = "nrf51-soc.sram-size=32768";
-
-/// Extra QEMU options of a target's machine.
-fn machine_options(target: &str) -> &'static [&'static str] {
-    if target == "thumbv6m-none-eabi" {
-        &["-global", M0_RAM]
-    } else {
-        &[]
-    }
-}
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -229,7 +215,6 @@ fn qemu(suites: bool) -> bool {
         let ran = built && {
             let mut q = Command::new("timeout");
             q.args(["60", "qemu-system-arm", "-machine", machine, "-cpu", cpu])
-                .args(machine_options(target))
                 .args(["-display", "none", "-semihosting-config"])
                 .arg("enable=on,target=native")
                 .arg("-kernel")

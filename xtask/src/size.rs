@@ -12,7 +12,7 @@
 //! Output: the human tables, then as the last line one JSON object
 //! `{"<target>": {"<probe>": {"text": N, "rodata": N, "bss": N, "stack": N}}}` (bytes).
 
-use crate::{cargo, elf, machine_options, run, TARGETS};
+use crate::{cargo, elf, run, TARGETS};
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::{Bvh, Node, Triangle};
 use std::io::{BufRead, BufReader, Write};
@@ -36,7 +36,7 @@ const PROBES: [Probe; 3] = [
     Probe {
         name: "render_bvh",
         bin: "size_probe_render",
-        what: "the default scene in f32, a BVH per object: scene conversion, `Renderer::new`, one row of sRGB pixels (the scene's buffers in statics, `.bss`)",
+        what: "the default scene in f32, a SAH BVH per object without reinsertion (`BvhFamily<StaticBuild<Sah, false>>`), the renderer's parts the scene uses (`RenderFeatures`): scene conversion, `Renderer::with_features`, one row of sRGB pixels (the scene's buffers in statics, `.bss`)",
     },
     Probe {
         name: "traverse_baked",
@@ -191,13 +191,7 @@ fn largest(syms: &[Symbol]) -> Vec<(u64, String)> {
 }
 
 /// Runs `elf` under QEMU with its free RAM painted and returns the bytes of stack it used.
-fn measure_stack(
-    target: &str,
-    machine: &str,
-    cpu: &str,
-    elf: &Path,
-    syms: &[Symbol],
-) -> Result<u64, String> {
+fn measure_stack(machine: &str, cpu: &str, elf: &Path, syms: &[Symbol]) -> Result<u64, String> {
     let addr = |name: &str| {
         syms.iter()
             .find(|s| s.name == name)
@@ -224,7 +218,6 @@ fn measure_stack(
     let _ = std::fs::remove_file(&dump_file);
     let mut qemu = Command::new("qemu-system-arm")
         .args(["-machine", machine, "-cpu", cpu])
-        .args(machine_options(target))
         .args([
             "-display", "none", "-monitor", "none", "-serial", "none", "-qmp", "stdio",
         ])
@@ -335,7 +328,7 @@ fn footprint(target: &str, machine: &str, cpu: &str, probe: &Probe) -> Result<Fo
     let path = elf(target, "release", probe.bin);
     let (text, rodata, bss) = sections(&path).ok_or("arm-none-eabi-size failed")?;
     let syms = symbols(&path).ok_or("arm-none-eabi-nm failed")?;
-    let stack = measure_stack(target, machine, cpu, &path, &syms);
+    let stack = measure_stack(machine, cpu, &path, &syms);
     if let Err(e) = &stack {
         println!("{}: stack not measured: {e}", probe.name);
     }

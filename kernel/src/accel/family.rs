@@ -2,7 +2,7 @@
 //! family (the renderer) links that structure alone. [`AnyFamily`] is the run-time choice.
 
 use super::any::AnyAccel;
-use super::bvh::{BuildOptions, Bvh};
+use super::bvh::{BuildOptions, BuildSettings, Bvh};
 use super::bvh4::Bvh4;
 use super::grid::{Grid, GridOptions};
 use super::kdtree::{KdOptions, KdTree};
@@ -22,6 +22,11 @@ pub trait AccelFamily<S: Scalar>: Copy + Debug + 'static {
     type Accel<'a, P: Primitive<S> + 'a>: Accel<S> + Copy + Debug;
     /// What the caller chooses at run time.
     type Options: Copy + Debug + PartialEq;
+    /// How the renderer builds its BVH over the objects (with its `Default` value):
+    /// [`BuildOptions`] for every family but a [`BvhFamily`] with settings named at compile
+    /// time, which builds it with that settings type, so a pass the family leaves out is not
+    /// linked for the objects either.
+    type TopLevel: BuildSettings + Default;
     /// Whether code generic over the family handles spheres. With `false`, sphere arms are
     /// constant-false branches (dead code) and sphere inputs are refused.
     const SPHERES: bool = true;
@@ -54,9 +59,11 @@ pub struct AnyFamily;
 #[derive(Clone, Copy, Debug)]
 pub struct LinearFamily;
 
-/// The binary BVH, [`Bvh`].
+/// The binary BVH, [`Bvh`], built with settings of type `B`: [`BuildOptions`] chosen at run
+/// time, or a [`crate::bvh::StaticBuild`] that links one split rule and, if it names it, the
+/// reinsertion pass.
 #[derive(Clone, Copy, Debug)]
-pub struct BvhFamily;
+pub struct BvhFamily<B = BuildOptions>(PhantomData<B>);
 
 /// The 4-wide BVH, [`Bvh4`].
 #[derive(Clone, Copy, Debug)]
@@ -77,6 +84,7 @@ pub struct TrianglesOnly<F>(PhantomData<F>);
 impl<S: Scalar> AccelFamily<S> for AnyFamily {
     type Accel<'a, P: Primitive<S> + 'a> = AnyAccel<'a, S, P>;
     type Options = AccelKind;
+    type TopLevel = BuildOptions;
 
     fn memory_needed<P: Primitive<S>>(
         kind: &AccelKind,
@@ -97,6 +105,7 @@ impl<S: Scalar> AccelFamily<S> for AnyFamily {
 impl<S: Scalar> AccelFamily<S> for LinearFamily {
     type Accel<'a, P: Primitive<S> + 'a> = Linear<'a, S, P>;
     type Options = ();
+    type TopLevel = BuildOptions;
 
     fn memory_needed<P: Primitive<S>>(_: &(), prims: &[P]) -> Result<MemoryNeeded, BuildError> {
         check_count(prims.len())?;
@@ -114,20 +123,21 @@ impl<S: Scalar> AccelFamily<S> for LinearFamily {
     }
 }
 
-impl<S: Scalar> AccelFamily<S> for BvhFamily {
+impl<S: Scalar, B> AccelFamily<S> for BvhFamily<B>
+where
+    B: BuildSettings + Default + Debug + PartialEq + 'static,
+{
     type Accel<'a, P: Primitive<S> + 'a> = Bvh<'a, S, P>;
-    type Options = BuildOptions;
+    type Options = B;
+    type TopLevel = B;
 
-    fn memory_needed<P: Primitive<S>>(
-        _: &BuildOptions,
-        prims: &[P],
-    ) -> Result<MemoryNeeded, BuildError> {
+    fn memory_needed<P: Primitive<S>>(_: &B, prims: &[P]) -> Result<MemoryNeeded, BuildError> {
         check_count(prims.len())?;
         Ok(MemoryNeeded::bvh(prims.len()))
     }
 
     fn build<'a, P: Primitive<S> + 'a>(
-        options: &BuildOptions,
+        options: &B,
         prims: &'a [P],
         memory: &mut AccelMemory<'a, S>,
     ) -> Result<Bvh<'a, S, P>, BuildError> {
@@ -141,6 +151,7 @@ impl<S: Scalar> AccelFamily<S> for BvhFamily {
 impl<S: Scalar> AccelFamily<S> for Bvh4Family {
     type Accel<'a, P: Primitive<S> + 'a> = Bvh4<'a, S, P>;
     type Options = BuildOptions;
+    type TopLevel = BuildOptions;
 
     fn memory_needed<P: Primitive<S>>(
         _: &BuildOptions,
@@ -167,6 +178,7 @@ impl<S: Scalar> AccelFamily<S> for Bvh4Family {
 impl<S: Scalar> AccelFamily<S> for GridFamily {
     type Accel<'a, P: Primitive<S> + 'a> = Grid<'a, S, P>;
     type Options = GridOptions;
+    type TopLevel = BuildOptions;
 
     fn memory_needed<P: Primitive<S>>(
         options: &GridOptions,
@@ -191,6 +203,7 @@ impl<S: Scalar> AccelFamily<S> for GridFamily {
 impl<S: Scalar> AccelFamily<S> for KdTreeFamily {
     type Accel<'a, P: Primitive<S> + 'a> = KdTree<'a, S, P>;
     type Options = KdOptions;
+    type TopLevel = BuildOptions;
 
     fn memory_needed<P: Primitive<S>>(
         _: &KdOptions,
@@ -215,6 +228,7 @@ impl<S: Scalar> AccelFamily<S> for KdTreeFamily {
 impl<S: Scalar, F: AccelFamily<S>> AccelFamily<S> for TrianglesOnly<F> {
     type Accel<'a, P: Primitive<S> + 'a> = F::Accel<'a, P>;
     type Options = F::Options;
+    type TopLevel = F::TopLevel;
     const SPHERES: bool = false;
 
     fn memory_needed<P: Primitive<S>>(

@@ -19,7 +19,7 @@ use super::motion::displacement;
 use super::objects::ObjectGeom;
 use super::sampling::{power_heuristic, to_world, uniform_cone, SampleStream};
 use super::scene::Shape;
-use super::Renderer;
+use super::{RenderFeatures, Renderer};
 use crate::accel::AccelFamily;
 use crate::geom::spawn::SpawnScalar;
 use crate::geom::Triangle;
@@ -40,8 +40,8 @@ pub(super) struct EmitterSample {
 
 /// The object holding emissive primitive `k` (`k < Geometry::emitter_count`) and `k`'s index
 /// within it.
-fn emitter<'g, 'a, S: SpawnScalar, F: AccelFamily<S>>(
-    r: &'g Renderer<'a, S, F>,
+fn emitter<'g, 'a, S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    r: &'g Renderer<'a, S, F, K>,
     k: u32,
 ) -> Option<(&'g ObjectGeom<'a, S, F>, u32)> {
     // The last object whose running count is at most `k` is the emitter holding it (objects
@@ -66,8 +66,8 @@ fn corners<S: SpawnScalar>(tri: &Triangle<S>, d: [f64; 3]) -> [Vec3; 3] {
 /// `None` when the sample contributes nothing (below the horizon, behind a one-sided
 /// emitter, inside a sphere).
 #[allow(clippy::too_many_arguments)]
-pub(super) fn sample<S: SpawnScalar, F: AccelFamily<S>>(
-    r: &Renderer<'_, S, F>,
+pub(super) fn sample<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    r: &Renderer<'_, S, F, K>,
     pf: Vec3,
     nf: Vec3,
     lobe: Lobe,
@@ -166,8 +166,8 @@ pub(super) fn sample<S: SpawnScalar, F: AccelFamily<S>>(
 /// towards primitive `local` of object `object`, which a ray along `dir` hit at distance `t`
 /// (0 where it cannot: not an emitter, inside a sphere, a degenerate triangle).
 #[cfg_attr(not(feature = "path-tracing"), allow(dead_code))]
-pub(super) fn density<S: SpawnScalar, F: AccelFamily<S>>(
-    r: &Renderer<'_, S, F>,
+pub(super) fn density<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    r: &Renderer<'_, S, F, K>,
     object: usize,
     local: u32,
     t: f32,

@@ -7,6 +7,7 @@
 //!
 //! Motion is in [`super::motion`]; leaving a surface in [`super::surface`].
 
+use super::features::RenderFeatures;
 use super::lights::{light_geom, LightGeom, MAX_LIGHTS};
 use super::memory::{memory_needed, RenderMemory};
 use super::motion::{displacement, moved_into_frame, swept_box};
@@ -14,7 +15,7 @@ use super::objects::{ObjectGeom, ObjectSlot, ShapeAccel};
 use super::scene::{Item, Light, Material, Object, Problem, Shape};
 use super::surface::{Prim, SurfacePoint};
 use super::SceneError;
-use crate::accel::bvh::{BuildOptions, Bvh};
+use crate::accel::bvh::Bvh;
 use crate::accel::{take, AccelFamily, BuildError, Counters, MemoryNeeded};
 use crate::geom::spawn::{cross, sub, unit, SpawnScalar};
 use crate::geom::{closer, Aabb, Primitive, Ray, Sphere};
@@ -64,7 +65,7 @@ pub(crate) struct Geometry<'a, S: Scalar, F: AccelFamily<S>> {
 
 impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     /// Builds every object's accelerator into the caller's memory ([`memory_needed`]).
-    pub(crate) fn build(
+    pub(crate) fn build<K: RenderFeatures>(
         objects: &'a [Object<'a, S>],
         materials: &[Material],
         lights: &[Light],
@@ -147,7 +148,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
             let need = MemoryNeeded::bvh(slots.len());
             let nodes = take(&mut memory.nodes, need.nodes);
             let ids = take(&mut memory.words, need.words);
-            let tree = Bvh::build(slots, nodes, ids, BuildOptions::DEFAULT)
+            let tree = Bvh::build(slots, nodes, ids, F::TopLevel::default())
                 .map_err(|e| err(0, "objects", Problem::Build(e)))?;
             Some(tree)
         } else {
@@ -162,7 +163,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
         };
         for (i, l) in lights.iter().enumerate() {
             let _ = geo.lights.push(
-                light_geom(l)
+                light_geom::<S, K>(l)
                     .map_err(|(field, problem)| SceneError::new(Item::Light, i, field, problem))?,
             );
         }
@@ -327,7 +328,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     /// ray), and what [`SurfacePoint::spawn_origin`] needs to leave it. `None` for lights.
     /// Inlined on hosted targets into both integrators (see `lighting::visible`).
     #[cfg_attr(not(target_os = "none"), inline(always))]
-    pub(crate) fn surface_point(
+    pub(crate) fn surface_point<K: RenderFeatures>(
         &self,
         ray: &Ray<S>,
         h: &SceneHit<S>,
@@ -355,6 +356,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
                 let shading = o
                     .vertex_normals
                     .get(local as usize)
+                    .filter(|_| K::SMOOTH_SHADING)
                     .and_then(|corners| interpolated_normal(corners, u, w, &n))
                     .unwrap_or(n);
                 Some(SurfacePoint {

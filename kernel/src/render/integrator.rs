@@ -8,7 +8,7 @@ use super::lighting::{light_sum, Lobe};
 use super::sampling::{gaussian, phong_lobe, tent, to_world, SampleStream};
 use super::scene::{Filter, Light, Material};
 use super::surface::dir_in_mode;
-use super::{RenderPlan, RenderStats, Renderer};
+use super::{RenderFeatures, RenderPlan, RenderStats, Renderer};
 use crate::accel::AccelFamily;
 use crate::accel::NoStats;
 use crate::geom::spawn::SpawnScalar;
@@ -24,8 +24,8 @@ use glam::Vec3;
 /// tenth. Bare-metal targets keep the optimiser's choice, for flash (see `ray_data` in
 /// `scalar/float.rs`).
 #[cfg_attr(not(target_os = "none"), inline(always))]
-pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
-    r: &Renderer<'_, S, F>,
+pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    r: &Renderer<'_, S, F, K>,
     x: u32,
     y: u32,
     stream: &mut SampleStream,
@@ -55,10 +55,13 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
             }
             Surface::Object { object, .. } => object,
         };
-        if plan.one_sided && behind_one_sided(r, ray, &hit, time, object, unit_at(dir, depth)) {
+        if K::ONE_SIDED
+            && plan.one_sided
+            && behind_one_sided(r, ray, &hit, time, object, unit_at(dir, depth))
+        {
             break;
         }
-        if plan.emitting_objects {
+        if K::EMISSIVE_GEOMETRY && plan.emitting_objects {
             radiance += throughput * emission_of(r, object);
         }
         // Emitters end the path: no surface point needed.
@@ -70,7 +73,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
             }
             Some(m) => m,
         };
-        let Some(sp) = r.geometry.surface_point(ray, &hit, time) else {
+        let Some(sp) = r.geometry.surface_point::<K>(ray, &hit, time) else {
             break;
         };
         let dir_unit = unit_at(dir, depth);
@@ -129,8 +132,8 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
 /// the pixel position, lens and time drawn from `stream` in that order, as far as the plan uses
 /// them. Both integrators start their paths here.
 #[inline(always)]
-pub(crate) fn camera_sample<S: SpawnScalar, F: AccelFamily<S>>(
-    r: &Renderer<'_, S, F>,
+pub(crate) fn camera_sample<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    r: &Renderer<'_, S, F, K>,
     x: u32,
     y: u32,
     stream: &mut SampleStream,
@@ -142,12 +145,13 @@ pub(crate) fn camera_sample<S: SpawnScalar, F: AccelFamily<S>>(
     } else {
         let (a, b) = stream.next_2d();
         match plan.filter {
-            Filter::Box => (a, b),
-            Filter::Tent => (0.5 + tent(a), 0.5 + tent(b)),
-            Filter::Gaussian { sigma, radius } => (
+            Filter::Tent if K::FILTERS => (0.5 + tent(a), 0.5 + tent(b)),
+            Filter::Gaussian { sigma, radius } if K::FILTERS => (
                 0.5 + gaussian(a, sigma, radius),
                 0.5 + gaussian(b, sigma, radius),
             ),
+            // The box filter; the others only where `K` links them (`Renderer::new` checks).
+            _ => (a, b),
         }
     };
     let lens = plan.lens.then(|| stream.next_2d());
@@ -164,8 +168,8 @@ pub(crate) fn camera_sample<S: SpawnScalar, F: AccelFamily<S>>(
 /// bits as [`sample_radiance`] under that plan (the same operations in the same order),
 /// without its sample stream, path state and bounce loop.
 #[cfg_attr(not(target_os = "none"), inline(always))]
-pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>>(
-    r: &Renderer<'_, S, F>,
+pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    r: &Renderer<'_, S, F, K>,
     x: u32,
     y: u32,
     stats: &mut RenderStats,
@@ -185,13 +189,14 @@ pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>>(
             // Emitters add what they emit, as the general loop adds it; nothing is lit.
             Surface::Object { object, .. } => {
                 let plan = &r.plan;
-                if plan.one_sided
+                if K::ONE_SIDED
+                    && plan.one_sided
                     && behind_one_sided(r, ray, &hit, 0.0, object, d.normalize_or_zero())
                 {
                     return Vec3::ZERO;
                 }
                 let mut radiance = Vec3::ZERO;
-                if plan.emitting_objects {
+                if K::EMISSIVE_GEOMETRY && plan.emitting_objects {
                     radiance += Vec3::ONE * emission_of(r, object);
                 }
                 if let Some(Material::Emissive { radiance: e }) = material_of(r, object) {
@@ -207,8 +212,8 @@ pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>>(
 
 /// Object `object`'s material (`None` only for an index the renderer's checks rule out).
 #[inline]
-pub(super) fn material_of<'r, S: SpawnScalar, F: AccelFamily<S>>(
-    r: &'r Renderer<'_, S, F>,
+pub(super) fn material_of<'r, S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    r: &'r Renderer<'_, S, F, K>,
     object: usize,
 ) -> Option<&'r Material> {
     r.geometry
@@ -220,8 +225,8 @@ pub(super) fn material_of<'r, S: SpawnScalar, F: AccelFamily<S>>(
 /// the object is one-sided ([`super::Object::one_sided`]): the back is black and ends the path.
 /// The side is the one shading sees: the sign of `dir` against the surface point's normal.
 #[inline]
-pub(super) fn behind_one_sided<S: SpawnScalar, F: AccelFamily<S>>(
-    r: &Renderer<'_, S, F>,
+pub(super) fn behind_one_sided<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    r: &Renderer<'_, S, F, K>,
     ray: &Ray<S>,
     hit: &SceneHit<S>,
     time: f32,
@@ -237,8 +242,8 @@ pub(super) fn behind_one_sided<S: SpawnScalar, F: AccelFamily<S>>(
 /// Radiance object `object` emits ([`super::Object::emission`]; zero for an index the
 /// renderer's checks rule out).
 #[inline]
-pub(super) fn emission_of<S: SpawnScalar, F: AccelFamily<S>>(
-    r: &Renderer<'_, S, F>,
+pub(super) fn emission_of<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    r: &Renderer<'_, S, F, K>,
     object: usize,
 ) -> Vec3 {
     r.geometry
@@ -250,8 +255,8 @@ pub(super) fn emission_of<S: SpawnScalar, F: AccelFamily<S>>(
 /// material's (zero for an index the renderer's checks rule out).
 #[cfg_attr(not(feature = "path-tracing"), allow(dead_code))]
 #[inline]
-pub(super) fn emitted<S: SpawnScalar, F: AccelFamily<S>>(
-    r: &Renderer<'_, S, F>,
+pub(super) fn emitted<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    r: &Renderer<'_, S, F, K>,
     object: usize,
 ) -> Vec3 {
     r.geometry
@@ -275,8 +280,8 @@ pub(super) fn reflect(d: Vec3, n: Vec3) -> Vec3 {
 }
 
 /// Radiance a camera or reflection ray sees on light `i`'s surface.
-pub(super) fn light_seen<S: SpawnScalar, F: AccelFamily<S>>(
-    r: &Renderer<'_, S, F>,
+pub(super) fn light_seen<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    r: &Renderer<'_, S, F, K>,
     i: usize,
     dir: Vec3,
 ) -> Vec3 {
@@ -288,7 +293,9 @@ pub(super) fn light_seen<S: SpawnScalar, F: AccelFamily<S>>(
                 Vec3::ZERO
             }
         }
-        (Some(Light::Sphere { radiance, .. }), _) => Vec3::from_array(*radiance),
+        (Some(Light::Sphere { radiance, .. }), _) if K::SPHERE_LIGHTS => {
+            Vec3::from_array(*radiance)
+        }
         _ => Vec3::ZERO,
     }
 }

@@ -8,7 +8,7 @@ use super::lights::LightGeom;
 use super::sampling::{power_heuristic, to_world, uniform_cone, SampleStream};
 use super::scene::Light;
 use super::surface::{dir_in_mode, Facing, SurfacePoint};
-use super::{RenderStats, Renderer};
+use super::{RenderFeatures, RenderStats, Renderer};
 use crate::accel::{AccelFamily, NoStats};
 use crate::geom::spawn::{shadow_t_max, SpawnScalar};
 use crate::geom::Ray;
@@ -69,8 +69,8 @@ pub(super) fn phong_density(c: f32, exponent: f32) -> f32 {
 /// branch for what it does not use. Bare-metal targets keep one copy, for flash.
 #[allow(clippy::too_many_arguments)]
 #[cfg_attr(not(target_os = "none"), inline(always))]
-pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
-    r: &Renderer<'_, S, F>,
+pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    r: &Renderer<'_, S, F, K>,
     sp: &SurfacePoint<'_, S>,
     facing: Facing,
     lobe: Lobe,
@@ -89,7 +89,7 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
             Light::Point {
                 position,
                 intensity,
-            } => {
+            } if K::POINT_LIGHTS => {
                 let to = Vec3::from_array(position) - pf;
                 let d2 = to.length_squared();
                 let dist = sqrtf(d2);
@@ -132,7 +132,7 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
                 center,
                 radius,
                 radiance,
-            } => {
+            } if K::SPHERE_LIGHTS => {
                 let (a, b) = stream.next_2d();
                 let to_c = Vec3::from_array(center) - pf;
                 let dc2 = to_c.length_squared();
@@ -162,6 +162,8 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
                 };
                 ((pf + wi * t).to_array(), c)
             }
+            // Kinds `K` leaves out (`Renderer::new` refuses them).
+            Light::Point { .. } | Light::Sphere { .. } => continue,
         };
         if contribution == Vec3::ZERO || !facing.leaves(Vec3::from_array(target) - pf) {
             continue;
@@ -171,7 +173,7 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
             sum += contribution;
         }
     }
-    if r.plan.emissive_geometry {
+    if K::EMISSIVE_GEOMETRY && r.plan.emissive_geometry {
         sum += emitter_light(r, sp, facing, lobe, mis, time, stream, stats);
     }
     sum
@@ -182,8 +184,8 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>>(
 /// in their shading loop.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-fn emitter_light<S: SpawnScalar, F: AccelFamily<S>>(
-    r: &Renderer<'_, S, F>,
+fn emitter_light<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    r: &Renderer<'_, S, F, K>,
     sp: &SurfacePoint<'_, S>,
     facing: Facing,
     lobe: Lobe,
@@ -264,8 +266,8 @@ const EMITTER_SHORTEN: f64 = 1.0 / 1024.0;
 /// hosted targets as [`light_sum`] is (two integrators call it; left alone, the optimiser
 /// keeps it out of line and the direct integrator pays the calls).
 #[cfg_attr(not(target_os = "none"), inline(always))]
-fn visible<S: SpawnScalar, F: AccelFamily<S>>(
-    r: &Renderer<'_, S, F>,
+fn visible<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    r: &Renderer<'_, S, F, K>,
     sp: &SurfacePoint<'_, S>,
     target: [f32; 3],
     time: f32,

@@ -1,5 +1,6 @@
 //! Lights as geometry: their visible surfaces, checked and converted to the mode.
 
+use super::features::RenderFeatures;
 use super::scene::{Light, Problem};
 use crate::geom::spawn::{cross, unit};
 use crate::geom::{Primitive, Sphere, Triangle};
@@ -19,7 +20,10 @@ pub(crate) enum LightGeom<S: Scalar> {
     Sphere(Sphere<S>),
 }
 
-pub(super) fn light_geom<S: Scalar>(l: &Light) -> Result<LightGeom<S>, (&'static str, Problem)> {
+/// Light `l`'s surface in mode `S`; kinds `K` leaves out are refused.
+pub(super) fn light_geom<S: Scalar, K: RenderFeatures>(
+    l: &Light,
+) -> Result<LightGeom<S>, (&'static str, Problem)> {
     let pt = |p: [f32; 3], field| -> Result<[S; 3], (&'static str, Problem)> {
         let mut out = [S::ZERO; 3];
         for k in 0..3 {
@@ -28,6 +32,8 @@ pub(super) fn light_geom<S: Scalar>(l: &Light) -> Result<LightGeom<S>, (&'static
         Ok(out)
     };
     match *l {
+        Light::Point { .. } if !K::POINT_LIGHTS => Err(("point", Problem::NotLinked)),
+        Light::Sphere { .. } if !K::SPHERE_LIGHTS => Err(("sphere", Problem::NotLinked)),
         Light::Point {
             position,
             intensity,

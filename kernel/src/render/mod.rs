@@ -18,6 +18,7 @@
 
 mod camera;
 mod emitters;
+mod features;
 mod geometry;
 mod integrator;
 mod lighting;
@@ -33,6 +34,7 @@ pub mod scenes;
 mod srgb;
 mod surface;
 
+pub use features::{AllFeatures, RenderFeatures};
 pub use lights::MAX_LIGHTS;
 pub use memory::{memory_needed, RenderMemory, RenderMemoryNeeded};
 pub use objects::ObjectSlot;
@@ -49,6 +51,7 @@ use crate::geom::spawn::SpawnScalar;
 use crate::geom::Ray;
 use camera::CameraFrame;
 use core::fmt;
+use core::marker::PhantomData;
 use geometry::Geometry;
 use glam::Vec3;
 use sampling::Sampler;
@@ -280,9 +283,15 @@ impl RenderStats {
 /// A checked scene with its accelerators built, ready to render tiles. Every object's
 /// accelerator is of the family `F`: [`AnyFamily`] chooses at run time; naming one structure's
 /// family links that structure alone. Every family gives the same image, bit for bit (the
-/// accelerators return the same closest hit, ties to the lowest id).
+/// accelerators return the same closest hit, ties to the lowest id). `K` names the parts of
+/// the renderer linked beyond its core ([`RenderFeatures`]; [`AllFeatures`] by default).
 #[derive(Clone, Debug)]
-pub struct Renderer<'a, S: SpawnScalar, F: AccelFamily<S> = AnyFamily> {
+pub struct Renderer<
+    'a,
+    S: SpawnScalar,
+    F: AccelFamily<S> = AnyFamily,
+    K: RenderFeatures = AllFeatures,
+> {
     geometry: Geometry<'a, S, F>,
     materials: &'a [Material],
     lights: &'a [Light],
@@ -295,11 +304,13 @@ pub struct Renderer<'a, S: SpawnScalar, F: AccelFamily<S> = AnyFamily> {
     settings: Settings,
     sampler: Sampler,
     plan: RenderPlan,
+    features: PhantomData<K>,
 }
 
 impl<'a, S: SpawnScalar, F: AccelFamily<S>> Renderer<'a, S, F> {
     /// Checks the scene and settings, builds every object's accelerator with `accel` into
-    /// `memory` (at least what [`memory_needed`] gives) and derives the plan.
+    /// `memory` (at least what [`memory_needed`] gives) and derives the plan. Links every part
+    /// of the renderer ([`AllFeatures`]); [`Renderer::with_features`] links fewer.
     ///
     /// # Errors
     /// A [`SceneError`] naming the item, its index, the field and the problem: bad settings,
@@ -311,13 +322,30 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Renderer<'a, S, F> {
         accel: F::Options,
         memory: RenderMemory<'a, S, F>,
     ) -> Result<Self, SceneError> {
+        Self::with_features(scene, settings, accel, memory)
+    }
+}
+
+impl<'a, S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures> Renderer<'a, S, F, K> {
+    /// As [`Renderer::new`], linking only the parts of the renderer `K` names.
+    ///
+    /// # Errors
+    /// As [`Renderer::new`], and [`Problem::NotLinked`] for what the scene or settings need of
+    /// the parts `K` leaves out.
+    pub fn with_features(
+        scene: &Scene<'a, S>,
+        settings: Settings,
+        accel: F::Options,
+        memory: RenderMemory<'a, S, F>,
+    ) -> Result<Self, SceneError> {
         check_settings(&settings)?;
         check_materials(scene)?;
+        check_linked::<S, K>(scene, &settings)?;
         let camera = CameraFrame::new(&scene.camera, settings.width, settings.height)?;
         scene::check_rgb(scene.background, false)
             .map_err(|p| SceneError::new(Item::Settings, 0, "background", p))?;
         let geometry =
-            Geometry::build(scene.objects, scene.materials, scene.lights, &accel, memory)?;
+            Geometry::build::<K>(scene.objects, scene.materials, scene.lights, &accel, memory)?;
         Ok(Self {
             geometry,
             materials: scene.materials,
@@ -328,7 +356,14 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Renderer<'a, S, F> {
             settings,
             sampler: Sampler::new(settings.sampler, settings.spp, settings.seed),
             plan: RenderPlan::derive(scene, &settings),
+            features: PhantomData,
         })
+    }
+
+    /// True when the plan takes the first-hit loop and `K` links it.
+    #[inline]
+    fn first_hit_loop(&self) -> bool {
+        K::FIRST_HIT_LOOP && self.plan.camera_rays_only()
     }
 
     /// The plan derived from the scene and settings.
@@ -347,7 +382,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Renderer<'a, S, F> {
     /// outside the image are rendered as if the image extended there).
     #[must_use]
     pub fn pixel(&self, x: u32, y: u32, stats: &mut RenderStats) -> Rgb {
-        if self.plan.camera_rays_only() {
+        if self.first_hit_loop() {
             self.camera_ray_pixel(x, y, stats)
         } else {
             self.sampled_pixel(x, y, stats)
@@ -403,7 +438,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Renderer<'a, S, F> {
         stats: &mut RenderStats,
         mut put: impl FnMut(T, Rgb),
     ) {
-        if self.plan.camera_rays_only() {
+        if self.first_hit_loop() {
             tile.for_each_pixel(slots, |x, y, slot| {
                 put(slot, self.camera_ray_pixel(x, y, stats));
             });
@@ -537,6 +572,46 @@ fn check_settings(s: &Settings) -> Result<(), SceneError> {
         if max_length == 0 {
             return err("max_length", Problem::NotPositive);
         }
+    }
+    Ok(())
+}
+
+/// Refuses what the scene or settings need of the parts `K` leaves out.
+fn check_linked<S: SpawnScalar, K: RenderFeatures>(
+    scene: &Scene<'_, S>,
+    settings: &Settings,
+) -> Result<(), SceneError> {
+    if !K::FILTERS && !matches!(settings.filter, Filter::Box) {
+        return Err(SceneError::new(
+            Item::Settings,
+            0,
+            "filter",
+            Problem::NotLinked,
+        ));
+    }
+    for (i, l) in scene.lights.iter().enumerate() {
+        let field = match l {
+            Light::Point { .. } if !K::POINT_LIGHTS => "point",
+            Light::Sphere { .. } if !K::SPHERE_LIGHTS => "sphere",
+            _ => continue,
+        };
+        return Err(SceneError::new(Item::Light, i, field, Problem::NotLinked));
+    }
+    for (i, o) in scene.objects.iter().enumerate() {
+        let field = if !K::ONE_SIDED && o.one_sided {
+            "one_sided"
+        } else if !K::SMOOTH_SHADING && !o.vertex_normals.is_empty() {
+            "vertex_normals"
+        } else if K::EMISSIVE_GEOMETRY || o.shape.is_empty() {
+            continue;
+        } else if o.emission != [0.0; 3] {
+            "emission"
+        } else if geometry::emitted_by(o, scene.materials) != [0.0; 3] {
+            "material"
+        } else {
+            continue;
+        };
+        return Err(SceneError::new(Item::Object, i, field, Problem::NotLinked));
     }
     Ok(())
 }

@@ -24,7 +24,7 @@ use super::lighting::{light_pdf, light_sum, phong_density, Lobe};
 use super::sampling::{cosine_hemisphere, phong_lobe, to_world, SampleStream};
 use super::scene::{Integrator, Material};
 use super::surface::dir_in_mode;
-use super::{RenderStats, Renderer};
+use super::{RenderFeatures, RenderStats, Renderer};
 use crate::accel::{AccelFamily, NoStats};
 use crate::geom::spawn::SpawnScalar;
 use crate::geom::Ray;
@@ -51,8 +51,8 @@ enum Previous {
 /// Never inlined: a path costs many rays, so the call is nothing to it, while inlined into the
 /// pixel loop it would change how the optimiser treats the direct integrator's loop there.
 #[inline(never)]
-pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
-    r: &Renderer<'_, S, F>,
+pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+    r: &Renderer<'_, S, F, K>,
     x: u32,
     y: u32,
     max_length: u32,
@@ -91,10 +91,10 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
             Surface::Object { object, local } => (object, local),
         };
         let (object, local) = object;
-        if plan.one_sided && behind_one_sided(r, ray, &hit, time, object, dir) {
+        if K::ONE_SIDED && plan.one_sided && behind_one_sided(r, ray, &hit, time, object, dir) {
             break;
         }
-        if plan.emissive_geometry {
+        if K::EMISSIVE_GEOMETRY && plan.emissive_geometry {
             let le = emitted(r, object);
             if le != Vec3::ZERO {
                 // As for the lights above: weighted against next-event estimation's density.
@@ -122,7 +122,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>>(
         if segments >= max_length {
             break;
         }
-        let Some(sp) = r.geometry.surface_point(ray, &hit, time) else {
+        let Some(sp) = r.geometry.surface_point::<K>(ray, &hit, time) else {
             break;
         };
         // Two-sided surfaces: shade with the normals facing the incoming ray.

@@ -11,7 +11,7 @@ use panic_probe as _;
 
 use raykernel::render::scenes;
 use raykernel::I16F16;
-use raykernel_qemu::{cases, check_render_golden, stack};
+use raykernel_qemu::{cases, check_render_golden, render_hash, stack};
 
 #[defmt::panic_handler]
 fn defmt_panic() -> ! {
@@ -27,6 +27,12 @@ unsafe fn HardFault(_: &cortex_m_rt::ExceptionFrame) -> ! {
 #[defmt_test::tests]
 mod tests {
     use super::*;
+
+    /// Paints the free stack, so that a test after the renders can report their peak.
+    #[init]
+    fn init() {
+        stack::paint(cortex_m::register::msp::read() as usize - 256);
+    }
 
     #[test]
     fn golden_render_cornell_fixed() {
@@ -52,12 +58,26 @@ mod tests {
     fn golden_render_emitters_path_fixed() {
         check_render_golden::<I16F16>("render_emitters_path_fixed", &cases::EMITTERS_PATH)
     }
+    /// How much of the RAM the golden renders left free (the stack was painted by `init`).
+    /// Fails when less than 512 bytes stay free, before an overflow would.
+    #[test]
+    fn stack_headroom_of_the_golden_renders() {
+        let top = stack::stack_top();
+        let low = stack::lowest_used(top);
+        let free = low - stack::stack_bottom();
+        defmt::info!(
+            "stack peak of the renders: {=usize} B used, {=usize} B free",
+            top - low,
+            free
+        );
+        defmt::assert!(free >= 512, "only {=usize} bytes of stack left", free);
+    }
     /// Stack used by a whole render (scene conversion, per-object BVH builds, renderer, one
     /// row of pixels) of the default scene, printed for the footprint table.
     #[test]
     fn render_stack_high_water_mark() {
         let used = stack::stack_use(|| {
-            defmt::assert!(cases::render_hash::<I16F16>(&scenes::CORNELL).is_ok())
+            defmt::assert!(render_hash::<I16F16>(&scenes::CORNELL).is_ok())
         });
         defmt::println!("render stack high-water (fixed): {=usize} B", used);
     }
