@@ -1,11 +1,12 @@
 //! The distribution ray tracer: known-answer renders (radiance from analytic formulas),
 //! sampling functions against their known integrals and stratification properties, tile and
 //! order independence, the render plan, and every typed scene error.
+#![allow(clippy::disallowed_methods)] // glam's lengths are the independent reference here
 
 use raykernel::bvh::{BuildOptions, BuilderKind};
 use raykernel::render::sampling::{
-    concentric_disk, cosine_hemisphere, owen_scramble, permute, phong_lobe, sobol_0, sobol_1, tent,
-    to_world, uniform_cone, SampleStream,
+    ceil_sqrt, concentric_disk, cosine_hemisphere, owen_scramble, permute, phong_lobe,
+    sin_cos_turns, sobol_0, sobol_1, tent, to_world, uniform_cone, SampleStream,
 };
 use raykernel::render::scenes::{self, SceneData};
 use raykernel::render::{
@@ -360,6 +361,61 @@ fn grid_mean(n: u32, f: impl Fn(f32, f32) -> f64) -> f64 {
         }
     }
     sum / f64::from(n * n)
+}
+
+#[test]
+fn ceil_sqrt_is_the_least_root_at_or_above() {
+    let is_ceil = |n: u32, c: u32| {
+        let (c, n) = (u64::from(c), u64::from(n));
+        c * c >= n && (c == 1 || (c - 1) * (c - 1) < n)
+    };
+    assert_eq!(ceil_sqrt(0), 1);
+    let squares = (1..=65_535u32).flat_map(|r| [r * r - 1, r * r, r * r + 1]);
+    for n in (1..100_000)
+        .chain(squares)
+        .chain(u32::MAX - 100_000..=u32::MAX)
+    {
+        assert!(
+            is_ceil(n, ceil_sqrt(n)),
+            "ceil_sqrt({n}) = {}",
+            ceil_sqrt(n)
+        );
+    }
+}
+
+#[test]
+fn sin_cos_turns_is_within_two_tenths_of_a_millionth() {
+    // Every quarter turn exactly; then a dense sweep over two turns either way and the
+    // ranges the samplers use, against `f64` trigonometry.
+    for (t, want) in [
+        (0.0, (0.0, 1.0)),
+        (0.25, (1.0, 0.0)),
+        (0.5, (0.0, -1.0)),
+        (-0.25, (-1.0, 0.0)),
+    ] {
+        let (s, c) = sin_cos_turns(t);
+        assert_eq!(
+            (s.abs(), c.abs()),
+            (f32::abs(want.0), f32::abs(want.1)),
+            "t = {t}"
+        );
+        assert!(
+            s * want.0 >= 0.0 && c * want.1 >= 0.0,
+            "t = {t}: signs of {s}, {c}"
+        );
+    }
+    let mut worst = 0.0f64;
+    for i in -400_000..=400_000 {
+        let t = i as f32 / 200_000.0;
+        let (s, c) = sin_cos_turns(t);
+        let x = std::f64::consts::TAU * f64::from(t);
+        worst = worst
+            .max((f64::from(s) - x.sin()).abs())
+            .max((f64::from(c) - x.cos()).abs());
+    }
+    assert!(worst <= 2e-7, "worst error {worst:e}");
+    let (s, c) = sin_cos_turns(f32::NAN);
+    assert!(s.is_nan() && c.is_nan());
 }
 
 #[test]

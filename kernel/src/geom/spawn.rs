@@ -205,7 +205,7 @@ pub(crate) fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
         return None;
     }
     let s = v.map(|x| x / m);
-    let l = libm::sqrt(dot(&s, &s));
+    let l = crate::scalar::sqrt(dot(&s, &s));
     Some(s.map(|x| x / l))
 }
 
@@ -246,12 +246,16 @@ pub fn offset_origin<S: SpawnScalar>(tri: &Triangle<S>, u: S, v: S, toward: S::V
     let want = if s > 0.0 { 1 } else { -1 };
     let axis = {
         let a = n.map(libm::fabs);
-        if a[0] >= a[1] && a[0] >= a[2] {
-            0
-        } else if a[1] >= a[2] {
-            1
+        // Ties to the first axis. Written with `<` alone: one kind of `f64` comparison links
+        // one soft-float routine on cores without a double FPU (`n` is finite).
+        if a[0] < a[1] || a[0] < a[2] {
+            if a[1] < a[2] {
+                2
+            } else {
+                1
+            }
         } else {
-            2
+            0
         }
     };
     let up = (n[axis] > 0.0) == (s > 0.0);
@@ -305,7 +309,7 @@ pub fn spawn_shadow_ray<S: SpawnScalar>(
     let toward = S::point_from_f64(sub(&tf, &p));
     let o = offset_origin(tri, u, v, S::array_to_vec(toward));
     let d = sub(&tf, &o.map(S::to_f64));
-    let len = libm::sqrt(dot(&d, &d));
+    let len = crate::scalar::sqrt(dot(&d, &d));
     let dir = S::point_from_f64(d);
     let r = if dir.iter().all(|&x| x == S::ZERO) {
         // The offset vector is below the mode's resolution: keep its direction in f32.

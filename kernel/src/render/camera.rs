@@ -1,7 +1,8 @@
 //! Camera rays: pinhole or thin lens.
 
-use super::sampling::concentric_disk;
+use super::sampling::{concentric_disk, sin_cos_turns};
 use super::scene::{finite3, Camera, Item, Problem, SceneError};
+use super::vector;
 use crate::geom::Ray;
 use crate::scalar::Scalar;
 use glam::Vec3;
@@ -58,16 +59,18 @@ impl CameraFrame {
             return Err(err("focus_distance", p));
         }
         let eye = Vec3::from_array(c.eye);
-        let w = (Vec3::from_array(c.look_at) - eye).normalize_or_zero();
+        let w = vector::normalize_or_zero(Vec3::from_array(c.look_at) - eye);
         if w == Vec3::ZERO {
             return Err(err("look_at", Problem::Degenerate));
         }
-        let right = w.cross(Vec3::from_array(c.up)).normalize_or_zero();
+        let right = vector::normalize_or_zero(w.cross(Vec3::from_array(c.up)));
         if right == Vec3::ZERO {
             return Err(err("up", Problem::Degenerate));
         }
         let up = right.cross(w);
-        let half_h = libm::tanf(c.vfov_deg.to_radians() * 0.5);
+        // Half the field of view, in turns: `vfov_deg / 2 / 360`.
+        let (sin, cos) = sin_cos_turns(c.vfov_deg / 720.0);
+        let half_h = sin / cos;
         let aspect = width as f32 / height as f32;
         Ok(Self {
             eye,

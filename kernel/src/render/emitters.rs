@@ -19,6 +19,7 @@ use super::motion::displacement;
 use super::objects::ObjectGeom;
 use super::sampling::{power_heuristic, to_world, uniform_cone, SampleStream};
 use super::scene::Shape;
+use super::vector;
 use super::{RenderFeatures, Renderer};
 use crate::accel::AccelFamily;
 use crate::geom::spawn::SpawnScalar;
@@ -95,7 +96,7 @@ pub(super) fn sample<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
             let (e1, e2) = (v1 - v0, v2 - v0);
             let y = v0 + e1 * a + e2 * b;
             let cross = e1.cross(e2);
-            let twice_area = cross.length();
+            let twice_area = vector::length(cross);
             let to = y - pf;
             let d2 = to.length_squared();
             let dist = sqrtf(d2);
@@ -190,7 +191,7 @@ pub(super) fn density<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
             };
             let [v0, v1, v2] = corners(tri, d);
             let cross = (v1 - v0).cross(v2 - v0);
-            let twice_area = cross.length();
+            let twice_area = vector::length(cross);
             let cos_l = libm::fabsf(cross.dot(dir)) / twice_area;
             if cos_l <= 0.0 || cos_l.is_nan() {
                 return 0.0;

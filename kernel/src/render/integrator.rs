@@ -8,6 +8,7 @@ use super::lighting::{light_sum, Lobe};
 use super::sampling::{gaussian, phong_lobe, tent, to_world, SampleStream};
 use super::scene::{Filter, Light, Material};
 use super::surface::dir_in_mode;
+use super::vector;
 use super::{RenderFeatures, RenderPlan, RenderStats, Renderer};
 use crate::accel::AccelFamily;
 use crate::accel::NoStats;
@@ -110,7 +111,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatur
                     break;
                 }
                 throughput *= Vec3::from_array(*reflectance);
-                dir = lobe.normalize_or_zero();
+                dir = vector::normalize_or_zero(lobe);
             }
         }
         depth += 1;
@@ -185,13 +186,13 @@ pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFe
     let seen = match r.geometry.intersect(ray, 0.0, &mut NoStats) {
         None => Vec3::from_array(r.background),
         Some(hit) => match hit.surface {
-            Surface::Light { light } => light_seen(r, light, d.normalize_or_zero()),
+            Surface::Light { light } => light_seen(r, light, vector::normalize_or_zero(d)),
             // Emitters add what they emit, as the general loop adds it; nothing is lit.
             Surface::Object { object, .. } => {
                 let plan = &r.plan;
                 if K::ONE_SIDED
                     && plan.one_sided
-                    && behind_one_sided(r, ray, &hit, 0.0, object, d.normalize_or_zero())
+                    && behind_one_sided(r, ray, &hit, 0.0, object, vector::normalize_or_zero(d))
                 {
                     return Vec3::ZERO;
                 }
@@ -269,7 +270,7 @@ pub(super) fn emitted<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
 #[inline]
 fn unit_at(dir: Vec3, depth: u32) -> Vec3 {
     if depth == 0 {
-        dir.normalize_or_zero()
+        vector::normalize_or_zero(dir)
     } else {
         dir
     }

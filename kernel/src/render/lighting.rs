@@ -8,6 +8,7 @@ use super::lights::LightGeom;
 use super::sampling::{power_heuristic, to_world, uniform_cone, SampleStream};
 use super::scene::Light;
 use super::surface::{dir_in_mode, Facing, SurfacePoint};
+use super::vector;
 use super::{RenderFeatures, RenderStats, Renderer};
 use crate::accel::{AccelFamily, NoStats};
 use crate::geom::spawn::{shadow_t_max, SpawnScalar};
@@ -113,7 +114,7 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
                 let d2 = to.length_squared();
                 let dist = sqrtf(d2);
                 let cross = eu.cross(ev);
-                let area = cross.length();
+                let area = vector::length(cross);
                 let cos = nf.dot(to) / dist;
                 let cos_l = -cross.dot(to) / (area * dist);
                 if !(cos > 0.0 && cos_l > 0.0 && d2 > 0.0) {
@@ -232,7 +233,7 @@ pub(super) fn light_pdf<S: SpawnScalar, F: AccelFamily<S>>(
             Some(LightGeom::Rect(..)),
         ) => {
             let cross = Vec3::from_array(*edge_u).cross(Vec3::from_array(*edge_v));
-            let area = cross.length();
+            let area = vector::length(cross);
             let facing = -cross.dot(dir);
             if !(facing > 0.0 && area > 0.0) {
                 return 0.0;
@@ -286,8 +287,8 @@ fn visible<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
         f64::from(target[1]) - o[1],
         f64::from(target[2]) - o[2],
     ];
-    let len = libm::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    let dir = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32).normalize_or_zero();
+    let len = crate::scalar::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    let dir = vector::normalize_or_zero(Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32));
     let Ok(ray) = Ray::<S>::new(S::array_to_vec(origin), dir_in_mode::<S>(dir.to_array())) else {
         // Origin and target coincide (or the origin left the range): count as lit.
         return true;

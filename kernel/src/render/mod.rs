@@ -33,6 +33,7 @@ mod scene;
 pub mod scenes;
 mod srgb;
 mod surface;
+mod vector;
 
 pub use features::{AllFeatures, RenderFeatures};
 pub use lights::MAX_LIGHTS;

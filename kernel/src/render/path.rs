@@ -24,6 +24,7 @@ use super::lighting::{light_pdf, light_sum, phong_density, Lobe};
 use super::sampling::{cosine_hemisphere, phong_lobe, to_world, SampleStream};
 use super::scene::{Integrator, Material};
 use super::surface::dir_in_mode;
+use super::vector;
 use super::{RenderFeatures, RenderStats, Renderer};
 use crate::accel::{AccelFamily, NoStats};
 use crate::geom::spawn::SpawnScalar;
@@ -62,7 +63,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatur
     let plan = &r.plan;
     let (o, d, time) = camera_sample(r, x, y, stream, stats);
     let mut current = Ray::<S>::from_f32(o.to_array(), d.to_array(), 0.0, f32::INFINITY);
-    let mut dir = d.normalize_or_zero();
+    let mut dir = vector::normalize_or_zero(d);
     let mut throughput = Vec3::ONE;
     let mut radiance = Vec3::ZERO;
     let mut previous = Previous::Specular;
@@ -160,7 +161,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatur
                 let e = light_sum(r, &sp, facing, lobe, mis, time, stream, stats);
                 radiance += throughput * reflectance * e;
                 let (a, b) = stream.next_2d();
-                let wi = to_world(phong_lobe(a, b, *exponent), mirror).normalize_or_zero();
+                let wi = vector::normalize_or_zero(to_world(phong_lobe(a, b, *exponent), mirror));
                 if wi.dot(nf) <= 0.0 || !facing.leaves(wi) {
                     break;
                 }

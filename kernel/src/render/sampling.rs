@@ -14,7 +14,6 @@
 //!   Scrambling"): no tables, low discrepancy at every power-of-two sample count.
 
 use crate::scalar::sqrtf;
-use core::f32::consts::PI;
 use core::num::NonZeroU32;
 use glam::Vec3;
 
@@ -234,15 +233,22 @@ impl SampleStream {
 /// `⌈√n⌉` for `n >= 1` (1 for 0), in integers.
 #[must_use]
 pub fn ceil_sqrt(n: u32) -> u32 {
-    // An estimate from f64 (exact for squares below 2^52), then corrected in integers.
-    let mut c = (libm::sqrt(f64::from(n)) as u32).max(1);
-    while u64::from(c) * u64::from(c) < u64::from(n) {
-        c += 1;
+    // `⌊√n⌋` digit by digit (two bits of `n` per step), then one more unless `n` is a square.
+    let (mut rest, mut root) = (n, 0u32);
+    let mut bit = 1u32 << 30;
+    while bit > n {
+        bit >>= 2;
     }
-    while c > 1 && u64::from(c - 1) * u64::from(c - 1) >= u64::from(n) {
-        c -= 1;
+    while bit != 0 {
+        if rest >= root + bit {
+            rest -= root + bit;
+            root = (root >> 1) + bit;
+        } else {
+            root >>= 1;
+        }
+        bit >>= 2;
     }
-    c
+    (root + u32::from(rest != 0)).max(1)
 }
 
 /// Clamps a value that rounding may have pushed to 1 to the largest float below 1.
@@ -343,12 +349,14 @@ pub fn concentric_disk(u: f32, v: f32) -> (f32, f32) {
     if a == 0.0 && b == 0.0 {
         return (0.0, 0.0);
     }
-    let (r, phi) = if abs(a) > abs(b) {
-        (a, (PI / 4.0) * (b / a))
+    // The angle in turns: `(π/4)·(b/a)` is `(b/a)/8` of a turn.
+    let (r, turns) = if abs(a) > abs(b) {
+        (a, (b / a) * 0.125)
     } else {
-        (b, PI / 2.0 - (PI / 4.0) * (a / b))
+        (b, 0.25 - (a / b) * 0.125)
     };
-    (r * libm::cosf(phi), r * libm::sinf(phi))
+    let (sin, cos) = sin_cos_turns(turns);
+    (r * cos, r * sin)
 }
 
 /// A direction around `+z` with density `(n+1)/(2π)·cos^n θ` over the hemisphere (the
@@ -358,8 +366,8 @@ pub fn concentric_disk(u: f32, v: f32) -> (f32, f32) {
 pub fn phong_lobe(u: f32, v: f32, exponent: f32) -> Vec3 {
     let cos_t = libm::powf(1.0 - u, 1.0 / (exponent + 1.0));
     let sin_t = sqrtf(max0(1.0 - cos_t * cos_t));
-    let phi = 2.0 * PI * v;
-    Vec3::new(sin_t * libm::cosf(phi), sin_t * libm::sinf(phi), cos_t)
+    let (sin, cos) = sin_cos_turns(v);
+    Vec3::new(sin_t * cos, sin_t * sin, cos_t)
 }
 
 /// A direction around `+z` with density `cos θ / π` (Malley's method on the concentric disk).
@@ -375,8 +383,8 @@ pub fn cosine_hemisphere(u: f32, v: f32) -> Vec3 {
 pub fn uniform_cone(u: f32, v: f32, cos_max: f32) -> Vec3 {
     let cos_t = 1.0 - u * (1.0 - cos_max);
     let sin_t = sqrtf(max0(1.0 - cos_t * cos_t));
-    let phi = 2.0 * PI * v;
-    Vec3::new(sin_t * libm::cosf(phi), sin_t * libm::sinf(phi), cos_t)
+    let (sin, cos) = sin_cos_turns(v);
+    Vec3::new(sin_t * cos, sin_t * sin, cos_t)
 }
 
 /// The power heuristic (Veach 1997, exponent 2) for one sample of a strategy of density `a`
@@ -423,6 +431,35 @@ pub fn basis(n: Vec3) -> (Vec3, Vec3) {
 pub fn to_world(local: Vec3, n: Vec3) -> Vec3 {
     let (t, b) = basis(n);
     t * local.x + b * local.y + n * local.z
+}
+
+/// `(sin 2πt, cos 2πt)`: the sine and cosine of `t` turns, within 2·10⁻⁷ of the exact values
+/// for `|t| < 2^20` (NaN for NaN; no meaning beyond 2^20).
+///
+/// `4t` is exact, and so is its distance `r ∈ [-½, ½]` to the nearest integer `k`, the
+/// quadrant; `x = r·π/2 ∈ [-π/4, π/4]` goes through the Taylor series of `sin` and `cos` to
+/// degree 9 and 10 (truncation below 3·10⁻⁸ there). Plain `f32` products and sums, so the bits
+/// are the same on every platform; no `libm` trigonometry (whose argument reduction for any
+/// angle is larger than the rest of the sampling code).
+#[must_use]
+pub fn sin_cos_turns(t: f32) -> (f32, f32) {
+    let q = 4.0 * t;
+    let k = (q + if q < 0.0 { -0.5 } else { 0.5 }) as i32;
+    let x = (q - k as f32) * core::f32::consts::FRAC_PI_2;
+    let x2 = x * x;
+    let sin = x + x
+        * x2
+        * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362_880.0))));
+    let cos = 1.0
+        + x2 * (-0.5
+            + x2 * (1.0 / 24.0
+                + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40_320.0 + x2 * (-1.0 / 3_628_800.0)))));
+    match k & 3 {
+        0 => (sin, cos),
+        1 => (cos, -sin),
+        2 => (-sin, -cos),
+        _ => (-cos, sin),
+    }
 }
 
 fn abs(x: f32) -> f32 {

@@ -103,7 +103,9 @@ impl<S: SpawnScalar> SurfacePoint<'_, S> {
             Prim::Sphere(sp) => {
                 let n = self.normal.map(f64::from);
                 let t = toward.map(f64::from);
-                let outside = n[0] * t[0] + n[1] * t[1] + n[2] * t[2] >= 0.0;
+                // `<` alone, as in `spawn::offset_origin` (both vectors are finite).
+                let inward = n[0] * t[0] + n[1] * t[1] + n[2] * t[2] < 0.0;
+                let outside = !inward;
                 let c = sp.center.map(S::to_f64);
                 let r = sp.radius.to_f64();
                 let m = c.iter().fold(r, |m, x| libm::fmax(m, libm::fabs(*x) + r));

@@ -14,7 +14,7 @@ mod eft;
 mod rounded;
 mod sqrt;
 
-pub(crate) use sqrt::sqrtf;
+pub(crate) use sqrt::{sqrt, sqrtf};
 
 use super::lanes::F4;
 use super::sealed::Numerics;
@@ -172,7 +172,7 @@ pub(super) fn unit_dir_f64(d: [f64; 3]) -> Result<[f64; 3], RayError> {
     }
     let inv_m = 1.0 / m;
     let s = [d[0] * inv_m, d[1] * inv_m, d[2] * inv_m];
-    let inv_len = 1.0 / libm::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    let inv_len = 1.0 / sqrt::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
     Ok([s[0] * inv_len, s[1] * inv_len, s[2] * inv_len])
 }
 

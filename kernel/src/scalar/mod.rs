@@ -15,8 +15,8 @@ mod wide;
 
 pub use error::{PointError, RayError};
 pub use fixed::{Vec3x, FIXED_COORD_LIMIT, I16F16};
-pub(crate) use float::sqrtf;
 pub use float::F32_COORD_LIMIT;
+pub(crate) use float::{sqrt, sqrtf};
 
 use core::fmt::Debug;
 

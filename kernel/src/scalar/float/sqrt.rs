@@ -1,15 +1,16 @@
-//! The correctly rounded `f32` square root the kernel uses everywhere.
+//! The correctly rounded `f32` and `f64` square roots the kernel uses everywhere.
 //!
 //! IEEE 754 requires `sqrt` to be correctly rounded, so every implementation gives the same bits.
-//! Hosted targets call `libm::sqrtf`, an instruction on x86_64, aarch64 and wasm32. Bare-metal
+//! Hosted targets call `libm`, an instruction on x86_64, aarch64 and wasm32. Bare-metal
 //! ARM cores with a floating-point unit (the `eabihf` targets, e.g. the Cortex-M4F) run their
-//! `vsqrt.f32` instruction, reached through inline assembly (`unsafe`: stable Rust exposes
-//! no square root in `core`). Other bare-metal targets run the digit-by-digit integer root
-//! below: `libm`'s portable routine is larger in flash and carries a lookup table.
+//! `vsqrt.f32` instruction for `f32`, reached through inline assembly (`unsafe`: stable Rust
+//! exposes no square root in `core`). Other bare-metal roots run the digit-by-digit integer
+//! root below: `libm`'s portable routines are larger in flash and carry a lookup table.
 
 /// `√x`, correctly rounded: `-0` for `-0`, `+inf` for `+inf`, NaN for NaN and for `x < 0`.
 #[cfg(not(target_os = "none"))]
 #[inline(always)]
+#[allow(clippy::disallowed_methods)] // the one place that names it
 pub(crate) fn sqrtf(x: f32) -> f32 {
     libm::sqrtf(x)
 }
@@ -50,14 +51,39 @@ pub(crate) fn sqrtf(x: f32) -> f32 {
     integer_sqrt(x)
 }
 
-/// `√x` by integer arithmetic only, correctly rounded (round to nearest; a tie cannot occur).
-///
-/// `x = y·2^e` with `e` even and `y = m·2^-23` in `[1, 4)`. The digit-by-digit root decides
-/// `q = ⌊√y·2^24⌋` one bit at a time, from 2^24 down: with the remainder `y - (q·2^-24)²`
-/// kept as the integer `r = (y - (q·2^-24)²)·2^(24+i)` at step `i`, the bit `b = 2^(24-i)` is
-/// taken when `r >= 2q + b`. `q` holds the 24-bit significand and one bit more, which alone
-/// decides the rounding: `√y·2^24` is never an odd integer exactly (its square `m·2^25` is
-/// even), so the discarded remainder cannot make a tie.
+/// `√x` (`f64`), correctly rounded: `-0` for `-0`, `+inf` for `+inf`, NaN for NaN and for
+/// `x < 0`.
+#[cfg(not(target_os = "none"))]
+#[inline(always)]
+#[allow(clippy::disallowed_methods)] // the one place that names it
+pub(crate) fn sqrt(x: f64) -> f64 {
+    libm::sqrt(x)
+}
+
+/// `√x` (`f64`), correctly rounded: `-0` for `-0`, `+inf` for `+inf`, NaN for NaN and for
+/// `x < 0`.
+#[cfg(target_os = "none")]
+#[inline(never)]
+pub(crate) fn sqrt(x: f64) -> f64 {
+    integer_sqrt_f64(x)
+}
+
+/// `√x` (`f64`) by integer arithmetic only, as [`root_bits`].
+#[cfg_attr(not(target_os = "none"), allow(dead_code))]
+#[inline(always)]
+fn integer_sqrt_f64(x: f64) -> f64 {
+    // Decided on the bits: comparisons of `f64` are calls on a core without a double FPU.
+    let bits = x.to_bits();
+    if bits << 1 == 0 || bits >> 52 == 0x7ff {
+        return x; // ±0, +inf, +NaN
+    }
+    if bits >> 63 != 0 {
+        return f64::NAN; // below zero, -inf, -NaN
+    }
+    f64::from_bits(root_bits(bits, 52, 1023))
+}
+
+/// `√x` (`f32`) by integer arithmetic only, as [`root_bits`].
 #[cfg_attr(
     any(
         not(target_os = "none"),
@@ -67,27 +93,43 @@ pub(crate) fn sqrtf(x: f32) -> f32 {
 )]
 fn integer_sqrt(x: f32) -> f32 {
     let bits = x.to_bits();
-    if x == 0.0 || bits == f32::INFINITY.to_bits() || x.is_nan() {
-        return x; // ±0, +inf, NaN
+    if bits << 1 == 0 || bits >> 23 == 0xff {
+        return x; // ±0, +inf, +NaN
     }
-    if x < 0.0 {
-        return f32::NAN;
+    if bits >> 31 != 0 {
+        return f32::NAN; // below zero, -inf, -NaN
     }
-    let biased = (bits >> 23) as i32;
+    // The root of a 32-bit float fits in its 32 bits.
+    f32::from_bits(root_bits(u64::from(bits), 23, 127) as u32)
+}
+
+/// The bits of `√x`, correctly rounded (round to nearest; a tie cannot occur), for the bits of
+/// a positive finite float with `p` fraction bits and exponent bias `bias` (`f32`: 23, 127;
+/// `f64`: 52, 1023).
+///
+/// `x = y·2^e` with `e` even and `y = m·2^-p` in `[1, 4)`. The digit-by-digit root decides
+/// `q = ⌊√y·2^(p+1)⌋` one bit at a time, from `2^(p+1)` down: with the remainder
+/// `y - (q·2^-(p+1))²` kept as the integer `r = (y - (q·2^-(p+1))²)·2^(p+1+i)` at step `i`,
+/// the bit `b = 2^(p+1-i)` is taken when `r >= 2q + b`. `q` holds the significand and one
+/// bit more, which alone decides the rounding: `√y·2^(p+1)` is never an odd integer exactly
+/// (its square `m·2^(p+2)` is even), so the discarded remainder cannot make a tie.
+#[cfg_attr(not(target_os = "none"), allow(dead_code))]
+fn root_bits(bits: u64, p: u32, bias: i32) -> u64 {
+    let fraction = bits & ((1 << p) - 1);
+    let biased = (bits >> p) as i32;
     let (mut m, mut e) = if biased == 0 {
-        // Subnormal: normalise so the leading bit sits at bit 23.
-        let frac = bits & 0x007f_ffff;
-        let shift = frac.leading_zeros() as i32 - 8;
-        (frac << shift, -126 - shift)
+        // Subnormal: normalise so the leading bit sits at bit `p`.
+        let shift = fraction.leading_zeros() as i32 - (63 - p as i32);
+        (fraction << shift, 1 - bias - shift)
     } else {
-        ((bits & 0x007f_ffff) | 0x0080_0000, biased - 127)
+        (fraction | 1 << p, biased - bias)
     };
     if e & 1 != 0 {
         m <<= 1;
         e -= 1;
     }
-    // r < 2q + b at every step, so it stays below 2^27.
-    let (mut r, mut q, mut b) = (m << 1, 0u32, 1u32 << 24);
+    // r < 2q + b at every step, so it stays below 2^(p+4).
+    let (mut r, mut q, mut b) = (m << 1, 0u64, 1u64 << (p + 1));
     while b != 0 {
         let t = (q << 1) + b;
         if r >= t {
@@ -97,16 +139,17 @@ fn integer_sqrt(x: f32) -> f32 {
         r <<= 1;
         b >>= 1;
     }
-    // `q` is in [2^24, 2^25); rounded, the significand lies in `[2^23, 2^24]` (a carry into
-    // the exponent at 2^24 is what adding to the exponent field does).
+    // `q` is in [2^(p+1), 2^(p+2)); rounded, the significand lies in `[2^p, 2^(p+1)]` (a carry
+    // into the exponent at 2^(p+1) is what adding to the exponent field does).
     let significand = (q + 1) >> 1;
-    let exponent = (e / 2 + 126) as u32;
-    f32::from_bits((exponent << 23) + significand)
+    let exponent = (e / 2 + bias - 1) as u64;
+    (exponent << p) + significand
 }
 
 #[cfg(test)]
+#[allow(clippy::disallowed_methods)] // `libm` is the reference here
 mod tests {
-    use super::integer_sqrt;
+    use super::{integer_sqrt, integer_sqrt_f64};
 
     fn same(x: f32) {
         let (a, b) = (integer_sqrt(x), libm::sqrtf(x));
@@ -147,6 +190,45 @@ mod tests {
             state ^= state >> 7;
             state ^= state << 17;
             same(f32::from_bits((state >> 32) as u32));
+        }
+    }
+
+    #[test]
+    fn the_f64_root_matches_libm_on_subnormals_squares_and_random_bits() {
+        let same = |x: f64| {
+            let (a, b) = (integer_sqrt_f64(x), libm::sqrt(x));
+            assert!(
+                a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                "sqrt({x:e}): {a:e} vs {b:e}"
+            );
+        };
+        for x in [
+            0.0,
+            -0.0,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            -1.0,
+            f64::MAX,
+        ] {
+            same(x);
+        }
+        for bits in (1..=0x000f_ffff_ffff_ffffu64).step_by(0x0000_0100_0000_0001) {
+            same(f64::from_bits(bits)); // subnormals
+        }
+        for k in 1..=1_000_000u32 {
+            let r = f64::from(k);
+            for x in [r * r, r * r - 1.0, r * r + 1.0] {
+                same(x);
+            }
+        }
+        let mut state = 0x5eed_0000_0000_0002u64;
+        for _ in 0..2_000_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            same(f64::from_bits(state));
+            same(f64::from_bits(state >> 2)); // positive, small and subnormal exponents
         }
     }
 }
