@@ -17,7 +17,7 @@ use super::surface::{Prim, SurfacePoint};
 use super::SceneError;
 use crate::accel::bvh::Bvh;
 use crate::accel::{take, AccelFamily, BuildError, Counters, MemoryNeeded};
-use crate::geom::spawn::{cross, sub, unit, SpawnScalar};
+use crate::geom::spawn::{cross, sub, unit};
 use crate::geom::{closer, Aabb, Primitive, Ray, Sphere};
 use crate::scalar::Scalar;
 
@@ -63,7 +63,7 @@ pub(crate) struct Geometry<'a, S: Scalar, F: AccelFamily<S>> {
     pub(crate) emitter_count: u32,
 }
 
-impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
+impl<'a, S: Scalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     /// Builds every object's accelerator into the caller's memory ([`memory_needed`]).
     pub(crate) fn build<K: RenderFeatures>(
         objects: &'a [Object<'a, S>],
@@ -387,7 +387,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     }
 }
 
-impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
+impl<'a, S: Scalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     /// The unit geometric normal [`Geometry::surface_point`] gives for hit `h`, without the
     /// rest of the surface point (no barycentrics). `None` for lights.
     pub(crate) fn normal_at(&self, ray: &Ray<S>, h: &SceneHit<S>, time: f32) -> Option<[f32; 3]> {
@@ -412,14 +412,14 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
 }
 
 /// A triangle's unit geometric normal `(v1 − v0) × (v2 − v0)` (degenerate: against the ray).
-fn triangle_normal<S: SpawnScalar>(v: &[[f64; 3]; 3], ray: &Ray<S>) -> [f64; 3] {
+fn triangle_normal<S: Scalar>(v: &[[f64; 3]; 3], ray: &Ray<S>) -> [f64; 3] {
     unit(cross(&sub(&v[1], &v[0]), &sub(&v[2], &v[0])))
         .unwrap_or_else(|| S::ray_dir(ray.data()).map(|x| -x.to_f64()))
 }
 
 /// A sphere's unit outward normal at the ray's hit `t`, the sphere displaced by `d` (the hit
 /// point from the ray in the sphere's frame; at the centre: against the ray).
-fn sphere_normal<S: SpawnScalar>(sp: &Sphere<S>, ray: &Ray<S>, t: S, d: [f64; 3]) -> [f64; 3] {
+fn sphere_normal<S: Scalar>(sp: &Sphere<S>, ray: &Ray<S>, t: S, d: [f64; 3]) -> [f64; 3] {
     let c = sp.center.map(S::to_f64);
     let o3 = S::vec_to_array(ray.origin()).map(S::to_f64);
     let dir = S::ray_dir(ray.data()).map(S::to_f64);

@@ -11,8 +11,8 @@ use super::surface::dir_in_mode;
 use super::{RenderFeatures, RenderPlan, RenderStats, Renderer};
 use crate::accel::AccelFamily;
 use crate::accel::NoStats;
-use crate::geom::spawn::SpawnScalar;
 use crate::geom::Ray;
+use crate::scalar::Scalar;
 use core::f32::consts::FRAC_1_PI;
 use glam::Vec3;
 
@@ -24,7 +24,7 @@ use glam::Vec3;
 /// tenth. Bare-metal targets keep the optimiser's choice, for flash (see `ray_data` in
 /// `scalar/float.rs`).
 #[cfg_attr(not(target_os = "none"), inline(always))]
-pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(crate) fn sample_radiance<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     x: u32,
     y: u32,
@@ -132,7 +132,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatur
 /// the pixel position, lens and time drawn from `stream` in that order, as far as the plan uses
 /// them. Both integrators start their paths here.
 #[inline(always)]
-pub(crate) fn camera_sample<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(crate) fn camera_sample<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     x: u32,
     y: u32,
@@ -168,7 +168,7 @@ pub(crate) fn camera_sample<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures
 /// bits as [`sample_radiance`] under that plan (the same operations in the same order),
 /// without its sample stream, path state and bounce loop.
 #[cfg_attr(not(target_os = "none"), inline(always))]
-pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(crate) fn camera_ray_radiance<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     x: u32,
     y: u32,
@@ -212,7 +212,7 @@ pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFe
 
 /// Object `object`'s material (`None` only for an index the renderer's checks rule out).
 #[inline]
-pub(super) fn material_of<'r, S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(super) fn material_of<'r, S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &'r Renderer<'_, S, F, K>,
     object: usize,
 ) -> Option<&'r Material> {
@@ -225,7 +225,7 @@ pub(super) fn material_of<'r, S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatur
 /// the object is one-sided ([`super::Object::one_sided`]): the back is black and ends the path.
 /// The side is the one shading sees: the sign of `dir` against the surface point's normal.
 #[inline]
-pub(super) fn behind_one_sided<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(super) fn behind_one_sided<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     ray: &Ray<S>,
     hit: &SceneHit<S>,
@@ -242,7 +242,7 @@ pub(super) fn behind_one_sided<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatu
 /// Radiance object `object` emits ([`super::Object::emission`]; zero for an index the
 /// renderer's checks rule out).
 #[inline]
-pub(super) fn emission_of<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(super) fn emission_of<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     object: usize,
 ) -> Vec3 {
@@ -255,7 +255,7 @@ pub(super) fn emission_of<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
 /// material's (zero for an index the renderer's checks rule out).
 #[cfg_attr(not(feature = "path-tracing"), allow(dead_code))]
 #[inline]
-pub(super) fn emitted<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(super) fn emitted<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     object: usize,
 ) -> Vec3 {
@@ -280,7 +280,7 @@ pub(super) fn reflect(d: Vec3, n: Vec3) -> Vec3 {
 }
 
 /// Radiance a camera or reflection ray sees on light `i`'s surface.
-pub(super) fn light_seen<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(super) fn light_seen<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     i: usize,
     dir: Vec3,
