@@ -218,7 +218,7 @@ fn check_mode<S: Mode>(tris_f32: &[[[f32; 3]; 3]], rays_in: &[RayIn]) {
     let converted: Result<Vec<Triangle<S>>, (usize, usize, raykernel::PointError)> = tris_f32
         .iter()
         .enumerate()
-        .map(|(i, t)| Triangle::<S>::from_f32(*t).map_err(|(v, e)| (i, v, e)))
+        .map(|(i, t)| Triangle::<S>::from_f32(*t).map_err(|e| (i, e.vertex, e.error)))
         .collect();
     let tris = match converted {
         Ok(t) => t,

@@ -57,7 +57,9 @@ pub use accel::{
     LinearFamily, MemoryNeeded, Nearest, NoStats, TraversalStats, TrianglesOnly, UnknownAccel,
     MAX_PRIMS,
 };
-pub use geom::{spawn, Aabb, Hit, Primitive, Ray, Sphere, Triangle};
+pub use geom::{
+    spawn, Aabb, Barycentrics, Hit, Primitive, Ray, Sphere, Triangle, TriangleHit, VertexError,
+};
 pub use glam;
 pub use scalar::{
     PointError, RayData, RayError, Scalar, Vec3x, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16,

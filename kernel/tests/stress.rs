@@ -17,8 +17,8 @@ use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::spawn::{offset_origin, spawn_ray, spawn_shadow_ray};
 use raykernel::{
     grid::GridOptions, kdtree::KdOptions, Aabb, Accel, AccelKind, AccelVisitor, AnyAccel, Arena,
-    BuildError, Bvh, Hit, Linear, Node, PointError, Primitive, Ray, RayData, RayError, Scalar,
-    Triangle, Vec3x, I16F16,
+    Barycentrics, BuildError, Bvh, Hit, Linear, Node, PointError, Primitive, Ray, RayData,
+    RayError, Scalar, Triangle, Vec3x, VertexError, I16F16,
 };
 use raykernel_testkit::icosphere::unit_icosphere;
 use raykernel_testkit::memory::OwnedMemory;
@@ -264,7 +264,7 @@ impl Primitive<f32> for MtTri {
     fn bounds(&self) -> Aabb<f32> {
         self.0.bounds()
     }
-    fn check(&self) -> Result<(), (usize, PointError)> {
+    fn check(&self) -> Result<(), VertexError> {
         self.0.check()
     }
     fn hit_t(&self, ray: &RayData<f32>, t_min: f32, t_max: f32) -> Option<f32> {
@@ -272,8 +272,8 @@ impl Primitive<f32> for MtTri {
         let d = <f32 as Scalar>::ray_dir(ray);
         mt_t(o, d, &self.0.v, t_min, t_max)
     }
-    fn hit_uv(&self, _ray: &RayData<f32>) -> (f32, f32) {
-        (0.0, 0.0)
+    fn hit_uv(&self, _ray: &RayData<f32>) -> Barycentrics<f32> {
+        Barycentrics::ZERO
     }
 }
 
@@ -409,7 +409,7 @@ fn bunny() -> Option<Mesh> {
         let ray = Ray::<f32>::from_f32(o, d, 0.0, f32::INFINITY).unwrap();
         let mut h: Vec<f32> = tris
             .iter()
-            .filter_map(|t| t.intersect(&ray).map(|x| x.0))
+            .filter_map(|t| t.intersect(&ray).map(|x| x.t))
             .collect();
         h.sort_by(f32::total_cmp);
         h
@@ -1458,7 +1458,7 @@ fn bad_input<S: Mode>() {
                     PointError::NonFinite
                 };
                 check(format!("vertex {k} axis {j} = {x}"), &|| {
-                    Triangle::<S>::from_f32(v) == Err((k, expect))
+                    Triangle::<S>::from_f32(v) == Err(VertexError::new(k, expect))
                 });
                 // The builder must name the same vertex when handed unchecked data (f32 only:
                 // fixed point cannot hold such values).

@@ -18,7 +18,7 @@ use super::SceneError;
 use crate::accel::bvh::Bvh;
 use crate::accel::{take, AccelFamily, BuildError, Counters, MemoryNeeded};
 use crate::geom::spawn::{cross, sub, unit};
-use crate::geom::{closer, Aabb, Primitive, Ray, Sphere};
+use crate::geom::{closer, Aabb, Barycentrics, Primitive, Ray, Sphere};
 use crate::scalar::Scalar;
 
 /// What a closest hit found.
@@ -343,7 +343,7 @@ impl<'a, S: Scalar, F: AccelFamily<S>> Geometry<'a, S, F> {
             Shape::Triangles(t) => {
                 let tri = t.get(local as usize)?;
                 // Barycentrics as the accelerator gives them: from the ray in the object's frame.
-                let (hu, hv) = match o.motion {
+                let Barycentrics { u: hu, v: hv } = match o.motion {
                     None => tri.hit_uv(ray.data()),
                     Some(m) => tri.hit_uv(moved_into_frame::<S>(m, ray, time)?.data()),
                 };
