@@ -28,7 +28,7 @@ pub(crate) use input::{check_count, check_each};
 pub use kind::{AccelKind, UnknownAccel};
 pub use linear::Linear;
 pub(crate) use memory::take;
-pub use memory::{AccelMemory, MemoryNeeded};
+pub use memory::{AccelMemory, MemoryNeeded, Shortfall};
 
 use crate::geom::{Barycentrics, Hit, Primitive, Ray};
 use crate::scalar::Scalar;

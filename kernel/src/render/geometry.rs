@@ -90,8 +90,9 @@ impl<'a, S: Scalar, F: AccelFamily<S>> Geometry<'a, S, F> {
             let (needed, available) = (need.objects, slots.len());
             return Err(err(0, "objects", Problem::TooSmall { needed, available }));
         }
-        if let Some((field, needed, available)) = need.accel.first_shortfall(&memory.available()) {
-            return Err(err(0, field, Problem::TooSmall { needed, available }));
+        if let Some(s) = need.accel.first_shortfall(&memory.available()) {
+            let (needed, available) = (s.needed, s.available);
+            return Err(err(0, s.field, Problem::TooSmall { needed, available }));
         }
         let slots = take(&mut slots, objects.len());
         let mut base = 0u32;
