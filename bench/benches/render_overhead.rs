@@ -6,11 +6,10 @@
 //! `cargo bench -p raykernel-bench --bench render_overhead`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use raykernel::spawn::SpawnScalar;
-use raykernel::I16F16;
+use raykernel::{Scalar, I16F16};
 use raykernel_bench::overhead::{with_fixture, Workload, SIZE};
 
-fn bench_mode<S: SpawnScalar>(c: &mut Criterion) {
+fn bench_mode<S: Scalar>(c: &mut Criterion) {
     let len = (3 * SIZE * SIZE) as usize;
     for workload in Workload::ALL {
         let mut group =

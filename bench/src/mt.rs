@@ -5,7 +5,7 @@
 //! comparisons written so NaN rejects. It is not watertight: a shared edge is evaluated from
 //! different base vertices by its two triangles, so rays through it can miss both.
 
-use raykernel::{Aabb, PointError, Primitive, RayData, Scalar, Triangle};
+use raykernel::{Aabb, Barycentrics, Primitive, RayData, Scalar, Triangle, VertexError};
 
 /// A kernel triangle whose hit test is Möller–Trumbore in `f32` instead of the watertight one.
 /// Same bounds, so a BVH over these is the same tree as over the plain triangles.
@@ -17,7 +17,7 @@ impl Primitive<f32> for MtTriangle {
     fn bounds(&self) -> Aabb<f32> {
         self.0.bounds()
     }
-    fn check(&self) -> Result<(), (usize, PointError)> {
+    fn check(&self) -> Result<(), VertexError> {
         self.0.check()
     }
     #[inline(always)]
@@ -26,10 +26,11 @@ impl Primitive<f32> for MtTriangle {
         let d = <f32 as Scalar>::ray_dir(ray);
         moller_trumbore(&self.0.v, o, d, t_min, t_max).map(|(t, _, _)| t)
     }
-    fn hit_uv(&self, ray: &RayData<f32>) -> (f32, f32) {
+    fn hit_uv(&self, ray: &RayData<f32>) -> Barycentrics<f32> {
         let o = <f32 as Scalar>::ray_origin(ray);
         let d = <f32 as Scalar>::ray_dir(ray);
-        moller_trumbore(&self.0.v, o, d, 0.0, f32::INFINITY).map_or((0.0, 0.0), |(_, u, v)| (u, v))
+        moller_trumbore(&self.0.v, o, d, 0.0, f32::INFINITY)
+            .map_or(Barycentrics::ZERO, |(_, u, v)| Barycentrics { u, v })
     }
 }
 

@@ -10,8 +10,7 @@ use raykernel::render::{
     memory_needed, Camera, Light, Material, Object, ObjectSlot, RenderMemory, Renderer, Scene,
     Settings, Shape,
 };
-use raykernel::spawn::SpawnScalar;
-use raykernel::{AccelKind, AnyFamily, Sphere, I16F16};
+use raykernel::{AccelKind, AnyFamily, Scalar, Sphere, I16F16};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -48,7 +47,7 @@ pub struct ObjectsRow {
 }
 
 /// The `n` spheres: a grid on the ground, rows of [`ROW`], one unit apart.
-fn spheres<S: SpawnScalar>(n: usize) -> Vec<Sphere<S>> {
+fn spheres<S: Scalar>(n: usize) -> Vec<Sphere<S>> {
     (0..n)
         .filter_map(|i| {
             let (x, z) = ((i % ROW) as f32 + 0.5, (i / ROW) as f32 + 0.5);
@@ -76,7 +75,7 @@ fn camera(n: usize) -> Camera {
 
 /// A built renderer over `objects` with `accel`, handed to `f`; returns `f`'s result and the
 /// build time, ms.
-fn with_renderer<S: SpawnScalar, R>(
+fn with_renderer<S: Scalar, R>(
     objects: &[Object<'_, S>],
     accel: AccelKind,
     f: impl FnOnce(&Renderer<'_, S>) -> R,
@@ -115,7 +114,7 @@ fn with_renderer<S: SpawnScalar, R>(
 }
 
 /// Renders into a fresh buffer; returns the bytes and the time, ms.
-fn render<S: SpawnScalar>(r: &Renderer<'_, S>) -> (Vec<u8>, f64) {
+fn render<S: Scalar>(r: &Renderer<'_, S>) -> (Vec<u8>, f64) {
     let mut out = vec![0u8; 3 * (SIZE * SIZE) as usize];
     let start = Instant::now();
     r.render_srgb8(&mut out).expect("the buffer fits the image");
@@ -127,7 +126,7 @@ fn differing(a: &[u8], b: &[u8]) -> usize {
     a.iter().zip(b).filter(|(x, y)| x != y).count() + a.len().abs_diff(b.len())
 }
 
-fn measure<S: SpawnScalar>(mode: &'static str, n: usize, runs: usize) -> ObjectsRow {
+fn measure<S: Scalar>(mode: &'static str, n: usize, runs: usize) -> ObjectsRow {
     let spheres = spheres::<S>(n);
     let many: Vec<Object<'_, S>> = spheres
         .chunks(1)

@@ -20,8 +20,8 @@ use raykernel::render::{
     encode_srgb8, Camera, Light, Material, Object, ObjectSlot, RenderMemory, Renderer, Scene,
     Settings, Shape,
 };
-use raykernel::spawn::{spawn_shadow_ray, SpawnScalar};
-use raykernel::{Accel, AccelKind, AccelMemory, Bvh, Ray, Triangle, I16F16};
+use raykernel::spawn::spawn_shadow_ray;
+use raykernel::{Accel, AccelKind, AccelMemory, Bvh, Ray, Scalar, Triangle, I16F16};
 use serde::Serialize;
 use std::hint::black_box;
 use std::time::Instant;
@@ -67,7 +67,7 @@ impl Workload {
 }
 
 /// The icosphere on its floor, in mode `S`.
-fn geometry<S: SpawnScalar>() -> Vec<Triangle<S>> {
+fn geometry<S: Scalar>() -> Vec<Triangle<S>> {
     let (verts, faces) = raykernel_testkit::icosphere::unit_icosphere(5);
     let p = |i: u32| {
         let v = verts[i as usize];
@@ -96,7 +96,7 @@ fn camera_frame() -> (Vec3, Vec3, Vec3) {
 }
 
 /// Pixel `(x, y)`'s camera direction and its place in the output.
-fn pixel_ray<S: SpawnScalar>(x: u32, y: u32, frame: (Vec3, Vec3, Vec3)) -> (Option<Ray<S>>, Vec3) {
+fn pixel_ray<S: Scalar>(x: u32, y: u32, frame: (Vec3, Vec3, Vec3)) -> (Option<Ray<S>>, Vec3) {
     let (w, u, v) = frame;
     let sx = 2.0 * (x as f32 + 0.5) / SIZE as f32 - 1.0;
     let sy = 1.0 - 2.0 * (y as f32 + 0.5) / SIZE as f32;
@@ -119,7 +119,7 @@ fn write_rgb(out: &mut [u8], x: u32, y: u32, c: [f32; 3]) {
 /// Not inlined, like the renderer's tile loop: each is then one copy per mode in every binary,
 /// and the comparison does not depend on how a caller's closure happened to be compiled.
 #[inline(never)]
-fn bare_primary<S: SpawnScalar>(bvh: &Bvh<'_, S, Triangle<S>>, out: &mut [u8]) {
+fn bare_primary<S: Scalar>(bvh: &Bvh<'_, S, Triangle<S>>, out: &mut [u8]) {
     let frame = camera_frame();
     for y in 0..SIZE {
         for x in 0..SIZE {
@@ -135,11 +135,7 @@ fn bare_primary<S: SpawnScalar>(bvh: &Bvh<'_, S, Triangle<S>>, out: &mut [u8]) {
 /// The bare shadow caster: camera ray, closest hit, one shadow ray by the kernel's spawn rule,
 /// Lambert shading of a point light. Not inlined, as [`bare_primary`].
 #[inline(never)]
-fn bare_shadow<S: SpawnScalar>(
-    bvh: &Bvh<'_, S, Triangle<S>>,
-    tris: &[Triangle<S>],
-    out: &mut [u8],
-) {
+fn bare_shadow<S: Scalar>(bvh: &Bvh<'_, S, Triangle<S>>, tris: &[Triangle<S>], out: &mut [u8]) {
     let frame = camera_frame();
     let light = LIGHT.map(|x| S::coord_from_f32(x).unwrap_or(S::ZERO));
     for y in 0..SIZE {
@@ -176,7 +172,7 @@ fn bare_shadow<S: SpawnScalar>(
 ///
 /// # Panics
 /// If the fixed scene fails to build (it does not).
-pub fn with_fixture<S: SpawnScalar, R>(
+pub fn with_fixture<S: Scalar, R>(
     workload: Workload,
     f: impl FnOnce(&mut dyn FnMut(&mut [u8]), &mut dyn FnMut(&mut [u8])) -> R,
 ) -> R {
@@ -270,7 +266,7 @@ pub fn run(runs: usize) -> Vec<OverheadRow> {
     rows
 }
 
-fn measure<S: SpawnScalar>(workload: Workload, runs: usize) -> OverheadRow {
+fn measure<S: Scalar>(workload: Workload, runs: usize) -> OverheadRow {
     let len = (3 * SIZE * SIZE) as usize;
     let (mut a, mut b) = (vec![0u8; len], vec![0u8; len]);
     let (mut bare_ms, mut renderer_ms) = (Vec::new(), Vec::new());

@@ -13,9 +13,9 @@ use libfuzzer_sys::fuzz_target;
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::grid::GridOptions;
 use raykernel::kdtree::{self, KdOptions};
-use raykernel::spawn::{spawn_ray, SpawnScalar};
+use raykernel::spawn::spawn_ray;
 use raykernel::{
-    Accel, AccelKind, AnyAccel, Arena, BuildError, Bvh, Hit, Linear, Node, Ray, Triangle,
+    Accel, AccelKind, AnyAccel, Arena, BuildError, Bvh, Hit, Linear, Node, Ray, Scalar, Triangle,
     F32_COORD_LIMIT, I16F16,
 };
 use raykernel_testkit::memory::OwnedMemory;
@@ -152,7 +152,7 @@ fn scene(data: &[u8]) -> (Vec<[[f32; 3]; 3]>, Vec<RayIn>) {
     (tris, rays)
 }
 
-trait Mode: SpawnScalar {
+trait Mode: Scalar {
     fn bits(self) -> u32;
     /// The triangle as given, without range checks (so the builder has to reject it).
     fn unchecked(v: [[f32; 3]; 3]) -> Triangle<Self>;
@@ -218,7 +218,7 @@ fn check_mode<S: Mode>(tris_f32: &[[[f32; 3]; 3]], rays_in: &[RayIn]) {
     let converted: Result<Vec<Triangle<S>>, (usize, usize, raykernel::PointError)> = tris_f32
         .iter()
         .enumerate()
-        .map(|(i, t)| Triangle::<S>::from_f32(*t).map_err(|(v, e)| (i, v, e)))
+        .map(|(i, t)| Triangle::<S>::from_f32(*t).map_err(|e| (i, e.vertex, e.error)))
         .collect();
     let tris = match converted {
         Ok(t) => t,

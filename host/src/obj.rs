@@ -78,15 +78,15 @@ impl Mesh {
     pub fn kernel_triangles<S: Scalar>(&self, path: &Path) -> Result<Vec<Triangle<S>>, ObjError> {
         (0..self.triangles.len())
             .map(|id| {
-                Triangle::from_f32(self.triangle_f32(id)).map_err(|(corner, error)| {
-                    let vertex = self.triangles[id][corner] as usize;
+                Triangle::from_f32(self.triangle_f32(id)).map_err(|e| {
+                    let vertex = self.triangles[id][e.vertex] as usize;
                     ObjError::at(
                         path,
                         self.position_lines[vertex],
                         ObjErrorKind::UnusableVertex {
                             triangle: id,
                             mode: S::NAME,
-                            error,
+                            error: e.error,
                         },
                     )
                 })

@@ -13,7 +13,6 @@ use raykernel::render::{
     encode_srgb8, memory_needed, Object, ObjectSlot, RenderMemory, RenderPlan, RenderStats,
     Renderer, Rgb, SceneError, Settings, Shape, Tile,
 };
-use raykernel::spawn::SpawnScalar;
 use raykernel::{AccelKind, AnyFamily, Scalar, Sphere, Triangle, I16F16};
 use rayon::prelude::*;
 use std::io::Write;
@@ -106,7 +105,7 @@ pub struct Rendered {
 ///
 /// # Errors
 /// The kernel's [`SceneError`] (map it with [`crate::spec::SceneSpec::explain`]).
-pub fn with_renderer<S: SpawnScalar, R>(
+pub fn with_renderer<S: Scalar, R>(
     data: &SceneData<'_>,
     settings: Settings,
     accel: AccelKind,
@@ -152,7 +151,7 @@ pub fn plan(
     settings: Settings,
     mode: Mode,
 ) -> Result<RenderPlan, SceneError> {
-    fn go<S: SpawnScalar>(d: &SceneData<'_>, s: Settings) -> Result<RenderPlan, SceneError> {
+    fn go<S: Scalar>(d: &SceneData<'_>, s: Settings) -> Result<RenderPlan, SceneError> {
         with_renderer::<S, _>(d, s, AccelKind::Linear, |r| *r.plan()).map(|(p, _)| p)
     }
     match mode {
@@ -192,7 +191,7 @@ impl From<SceneError> for RenderError {
     }
 }
 
-fn render_in<S: SpawnScalar + Send + Sync>(
+fn render_in<S: Scalar + Send + Sync>(
     data: &SceneData<'_>,
     settings: Settings,
     options: &RenderOptions,
@@ -293,11 +292,7 @@ pub fn render_reference(
     mode: Mode,
     accel: AccelKind,
 ) -> Result<Image, SceneError> {
-    fn go<S: SpawnScalar>(
-        d: &SceneData<'_>,
-        s: Settings,
-        a: AccelKind,
-    ) -> Result<Image, SceneError> {
+    fn go<S: Scalar>(d: &SceneData<'_>, s: Settings, a: AccelKind) -> Result<Image, SceneError> {
         let mut rgb = vec![0u8; 3 * s.width as usize * s.height as usize];
         with_renderer::<S, _>(d, s, a, |r| r.render_srgb8(&mut rgb))?.0?;
         Ok(Image {

@@ -54,10 +54,12 @@ pub use accel::kdtree::{KdNode, KdTree};
 pub use accel::{
     Accel, AccelFamily, AccelKind, AccelMemory, AccelVisitor, AnyAccel, AnyFamily, Arena,
     BuildError, Bvh4Family, BvhFamily, Counters, GridFamily, InvalidAccel, KdTreeFamily, Linear,
-    LinearFamily, MemoryNeeded, Nearest, NoStats, TraversalStats, TrianglesOnly, UnknownAccel,
-    MAX_PRIMS,
+    LinearFamily, MemoryNeeded, Nearest, NoStats, Shortfall, TraversalStats, TrianglesOnly,
+    UnknownAccel, MAX_PRIMS,
 };
-pub use geom::{spawn, Aabb, Hit, Primitive, Ray, Sphere, Triangle};
+pub use geom::{
+    spawn, Aabb, Barycentrics, Hit, Primitive, Ray, Sphere, Triangle, TriangleHit, VertexError,
+};
 pub use glam;
 pub use scalar::{
     PointError, RayData, RayError, Scalar, Vec3x, F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16,
@@ -81,9 +83,9 @@ pub mod baked {
     };
 }
 
-/// Memory size of the 4-wide BVH, [`Bvh4`].
+/// Memory size and node slots of the 4-wide BVH, [`Bvh4`].
 pub mod bvh4 {
-    pub use crate::accel::bvh4::nodes4_needed;
+    pub use crate::accel::bvh4::{nodes4_needed, ChildSlot};
 }
 
 /// Settings, memory sizes and limits of the uniform grid, [`Grid`].

@@ -13,8 +13,7 @@ mod common;
 use raykernel::render::{
     Camera, Filter, Integrator, Light, Material, Object, SamplerKind, Scene, Settings, Shape,
 };
-use raykernel::spawn::SpawnScalar;
-use raykernel::{Sphere, Triangle, I16F16};
+use raykernel::{Scalar, Sphere, Triangle, I16F16};
 
 /// Standard errors a mean may lie from its expected value.
 const Z: f64 = 5.0;
@@ -31,7 +30,7 @@ fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
 
 /// The parallelogram `corner + a·u + b·v` as two triangles wound as the rectangle light's
 /// (front `u × v`).
-fn quad<S: SpawnScalar>(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> [Triangle<S>; 2] {
+fn quad<S: Scalar>(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> [Triangle<S>; 2] {
     let (a, b, c, d) = (
         corner,
         add(corner, u),
@@ -44,7 +43,7 @@ fn quad<S: SpawnScalar>(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> [Triangle
     ]
 }
 
-fn sphere<S: SpawnScalar>(c: [f32; 3], r: f32) -> Sphere<S> {
+fn sphere<S: Scalar>(c: [f32; 3], r: f32) -> Sphere<S> {
     Sphere {
         center: c.map(|x| S::coord_from_f32(x).unwrap()),
         radius: S::coord_from_f32(r).unwrap(),
@@ -52,7 +51,7 @@ fn sphere<S: SpawnScalar>(c: [f32; 3], r: f32) -> Sphere<S> {
 }
 
 /// A large floor at `y = 0`, front up.
-fn floor<S: SpawnScalar>() -> [Triangle<S>; 2] {
+fn floor<S: Scalar>() -> [Triangle<S>; 2] {
     quad([-50.0, 0.0, 50.0], [100.0, 0.0, 0.0], [0.0, 0.0, -100.0])
 }
 
@@ -95,7 +94,7 @@ fn difference(a: &[[f32; 3]], b: &[[f32; 3]], pixels: &[usize]) -> [(f64, f64); 
 
 /// The floor, a diffuse sphere on it, and the rectangle above them: as a [`Light::Rect`]
 /// (`mesh` false) or as a one-sided emissive mesh of two triangles.
-fn lit_scene_image<S: SpawnScalar>(mesh: bool, settings: Settings) -> Vec<[f32; 3]> {
+fn lit_scene_image<S: Scalar>(mesh: bool, settings: Settings) -> Vec<[f32; 3]> {
     let floor = floor::<S>();
     let ball = [sphere::<S>([0.3, 0.35, 0.0], 0.35)];
     let lamp = quad::<S>(CORNER, EDGE_U, EDGE_V);
@@ -144,7 +143,7 @@ fn lit_scene_image<S: SpawnScalar>(mesh: bool, settings: Settings) -> Vec<[f32; 
 
 /// In blocks of 8×8 pixels, the emissive mesh's image and the rectangle light's agree within
 /// the noise of their difference; over the whole image that noise is below 2% of the mean.
-fn mesh_matches_rect_case<S: SpawnScalar>() {
+fn mesh_matches_rect_case<S: Scalar>() {
     const W: u32 = 32;
     for integrator in integrators() {
         let rect = lit_scene_image::<S>(false, settings(integrator, W, 16, 5));
@@ -253,7 +252,7 @@ fn bsdf_sampling_alone(n: usize) -> (f64, f64) {
 
 /// The tilted quad as an emissive mesh over the floor, rendered under `integrator`; the mean
 /// of the red channel over the pixels and its standard error.
-fn tilted_mesh_radiance<S: SpawnScalar>(integrator: Integrator) -> (f64, f64) {
+fn tilted_mesh_radiance<S: Scalar>(integrator: Integrator) -> (f64, f64) {
     let floor = floor::<S>();
     let (c, u, v) = TILTED;
     let lamp = quad::<S>(c, u, v);
@@ -297,7 +296,7 @@ fn tilted_mesh_radiance<S: SpawnScalar>(integrator: Integrator) -> (f64, f64) {
 /// Next-event estimation on the mesh with MIS (path length 3: the floor point's light sample
 /// and its BSDF ray, which may hit the mesh, combined), next-event estimation alone (the direct
 /// integrator) and BSDF sampling alone converge to the same radiance.
-fn nee_matches_bsdf_case<S: SpawnScalar>() {
+fn nee_matches_bsdf_case<S: Scalar>() {
     let (want, want_se) = bsdf_sampling_alone(400_000);
     assert!(want > 0.1, "the quad must light the point: {want}");
     let mut cases = vec![Integrator::Direct];

@@ -13,7 +13,7 @@ use raykernel::bvh::{
 };
 use raykernel::Arena;
 use raykernel::{
-    Accel, BuildError, Bvh, Linear, Node, PointError, Ray, RayError, Sphere, Triangle,
+    Accel, BuildError, Bvh, Linear, Node, PointError, Ray, RayError, Sphere, Triangle, VertexError,
     F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16,
 };
 use raykernel_testkit::Rng;
@@ -170,7 +170,7 @@ fn from_f32_cases<S: TestScalar>() {
             let got = Triangle::<S>::from_f32(v).err();
             assert_eq!(
                 got,
-                want.map(|e| (vertex, e)),
+                want.map(|e| VertexError::new(vertex, e)),
                 "{} from_f32 with {x} at v{vertex}",
                 S::NAME
             );

@@ -8,7 +8,7 @@
 //! worse than the `f64` solve by more than that hair, and prints both distributions.
 //! Deterministic (seeded); a failure prints the seed index and the triangle.
 
-use raykernel::{Ray, Triangle};
+use raykernel::{Ray, Triangle, TriangleHit};
 use raykernel_testkit::vec3::{add_scaled, to_f32};
 use raykernel_testkit::Rng;
 
@@ -167,7 +167,7 @@ const BOUND: f64 = 0.5 + 1.0 / 256.0;
 
 /// Measures one ray/triangle pair if the kernel reports a hit there.
 fn measure(stats: &mut Stats, ray: &Ray<f32>, v: [[f32; 3]; 3], case: &str) {
-    let Some((t, _, _)) = Triangle { v }.intersect(ray) else {
+    let Some(TriangleHit { t, .. }) = Triangle { v }.intersect(ray) else {
         return;
     };
     let frame = Frame::new(ray);

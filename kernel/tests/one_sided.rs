@@ -7,12 +7,11 @@
 mod common;
 
 use raykernel::render::{Camera, Integrator, Light, Material, Object, Scene, Settings, Shape};
-use raykernel::spawn::SpawnScalar;
-use raykernel::{Triangle, I16F16};
+use raykernel::{Scalar, Triangle, I16F16};
 
 /// The quad `[-h, h]²` at height `z`, wound counter-clockwise seen from `+z` (front `+z`) or,
 /// with `flip`, from `-z`.
-fn quad<S: SpawnScalar>(h: f32, z: f32, flip: bool) -> [Triangle<S>; 2] {
+fn quad<S: Scalar>(h: f32, z: f32, flip: bool) -> [Triangle<S>; 2] {
     let p = |x: f32, y: f32| [x, y, z].map(|c| S::coord_from_f32(c).unwrap());
     let (a, b, c, d) = (p(-h, -h), p(h, -h), p(h, h), p(-h, h));
     if flip {
@@ -60,7 +59,7 @@ const MATERIALS: [Material; 1] = [Material::Diffuse {
 
 /// The quad (front `+z`) seen and lit from `side` (`+1`: the front, `-1`: the back), one-sided
 /// or not.
-fn quad_image<S: SpawnScalar>(side: f32, one_sided: bool, i: Integrator) -> Vec<[f32; 3]> {
+fn quad_image<S: Scalar>(side: f32, one_sided: bool, i: Integrator) -> Vec<[f32; 3]> {
     let tris = quad::<S>(1.0, 0.0, false);
     let objects = [Object {
         one_sided,
@@ -84,7 +83,7 @@ fn lit(px: &[[f32; 3]]) -> usize {
     px.iter().filter(|p| p.iter().any(|&c| c > 0.0)).count()
 }
 
-fn quad_case<S: SpawnScalar>() {
+fn quad_case<S: Scalar>() {
     for i in integrators() {
         let front = quad_image::<S>(1.0, true, i);
         assert_eq!(lit(&front), front.len(), "{i:?}: the quad fills the view");
@@ -114,7 +113,7 @@ fn one_sided_quad_is_black_from_behind_fixed() {
 /// A two-sided floor at `z = 0` seen from above, a light above it, and between them a
 /// one-sided quad at `z = 1` (wound with `flip`): with its front or its back to the light, the
 /// floor below it is in shadow.
-fn occluder_case<S: SpawnScalar>() {
+fn occluder_case<S: Scalar>() {
     for i in integrators() {
         let floor = quad::<S>(4.0, 0.0, false);
         let image = |occluder: Option<bool>| {

@@ -20,15 +20,16 @@ use raykernel::render::{
     memory_needed, Camera, Filter, Integrator, Light, Material, Object, ObjectSlot, RenderMemory,
     Renderer, SamplerKind, Scene, SceneError, Settings, Shape, Tile,
 };
-use raykernel::spawn::SpawnScalar;
-use raykernel::{AccelKind, AccelMemory, AnyFamily, KdNode, Node, Node4, Sphere, Triangle, I16F16};
+use raykernel::{
+    AccelKind, AccelMemory, AnyFamily, KdNode, Node, Node4, Scalar, Sphere, Triangle, I16F16,
+};
 
 /// Standard errors a mean may lie from its expected value (a false failure has probability
 /// below 1e-6 per channel; the renders are deterministic, so a test passes or fails always).
 const Z: f64 = 5.0;
 
 /// Renders `scene` into linear RGB with the default accelerator, `tile` by `tile` pixels.
-fn render_tiled<S: SpawnScalar>(
+fn render_tiled<S: Scalar>(
     scene: &Scene<'_, S>,
     settings: Settings,
     tile: u32,
@@ -72,7 +73,7 @@ fn render_tiled<S: SpawnScalar>(
     Ok(out)
 }
 
-fn render<S: SpawnScalar>(scene: &Scene<'_, S>, settings: Settings) -> Vec<[f32; 3]> {
+fn render<S: Scalar>(scene: &Scene<'_, S>, settings: Settings) -> Vec<[f32; 3]> {
     render_tiled(scene, settings, settings.width.max(settings.height)).unwrap()
 }
 
@@ -103,7 +104,7 @@ fn path(max_length: u32, width: u32, spp: u32, seed: u32) -> Settings {
     }
 }
 
-fn sphere<S: SpawnScalar>(c: [f32; 3], r: f32) -> Sphere<S> {
+fn sphere<S: Scalar>(c: [f32; 3], r: f32) -> Sphere<S> {
     Sphere {
         center: c.map(|x| S::coord_from_f32(x).unwrap()),
         radius: S::coord_from_f32(r).unwrap(),
@@ -113,7 +114,7 @@ fn sphere<S: SpawnScalar>(c: [f32; 3], r: f32) -> Sphere<S> {
 /// Camera inside a closed sphere whose surface is diffuse of albedo `a` and emits `Le`: the
 /// radiance everywhere is `Le · Σ aᵏ = Le / (1 − a)` (the path length, 256 segments, cuts
 /// off a share `a²⁵⁶` of it, far below the noise).
-fn furnace_case<S: SpawnScalar>() {
+fn furnace_case<S: Scalar>() {
     let albedo = [0.5f32, 0.7, 0.3];
     let emission = [1.0f32, 0.5, 2.0];
     let shell = [sphere::<S>([0.1, -0.2, 0.3], 1.5)];
@@ -207,7 +208,7 @@ fn mis_weights_of_two_strategies_sum_to_one() {
 }
 
 /// A large diffuse floor of albedo `ρ` at `y = 0`.
-fn floor_tris<S: SpawnScalar>() -> Vec<Triangle<S>> {
+fn floor_tris<S: Scalar>() -> Vec<Triangle<S>> {
     let s = 50.0;
     [
         [[-s, 0.0, -s], [-s, 0.0, s], [s, 0.0, s]],
@@ -235,7 +236,7 @@ fn narrow_camera(eye: [f32; 3]) -> Camera {
 /// light sample and its cosine-sampled ray (which hits the light with probability `(R/h)²`)
 /// are combined by MIS; counting either strategy's share twice or dropping it is off by far
 /// more than the bound. Length 2 (light samples alone) must give the same answer.
-fn sphere_light_case<S: SpawnScalar>() {
+fn sphere_light_case<S: Scalar>() {
     let (rho, radiance, r, h) = (0.6f32, 3.0f32, 0.8f32, 1.0f32);
     let t = floor_tris::<S>();
     let objects = [Object::new(Shape::Triangles(&t), 0)];
@@ -274,7 +275,7 @@ fn sphere_light_irradiance_through_mis_matches_the_formula() {
 /// A glossy floor under a rectangle and a sphere light, seen at an angle: light samples alone
 /// (length 2) and light samples with BSDF samples (length 3, MIS) estimate the same radiance,
 /// so their means agree within the noise of both.
-fn glossy_mis_case<S: SpawnScalar>() {
+fn glossy_mis_case<S: Scalar>() {
     let t = floor_tris::<S>();
     let objects = [Object::new(Shape::Triangles(&t), 0)];
     let lights = [
@@ -327,7 +328,7 @@ fn glossy_light_sampling_alone_and_with_mis_agree() {
 }
 
 /// The Cornell box with every material diffuse: black background, no emitting surfaces.
-fn diffuse_cornell<S: SpawnScalar, R>(f: impl FnOnce(&Scene<'_, S>, Settings) -> R) -> R {
+fn diffuse_cornell<S: Scalar, R>(f: impl FnOnce(&Scene<'_, S>, Settings) -> R) -> R {
     let d: SceneData<'_> = scenes::CORNELL;
     let materials: Vec<_> = d
         .materials
@@ -350,7 +351,7 @@ fn diffuse_cornell<S: SpawnScalar, R>(f: impl FnOnce(&Scene<'_, S>, Settings) ->
 
 /// The kernel's scene for `data` in mode `S` (primitives converted, objects filled), handed
 /// to `f` with the data's settings.
-fn with_scene<S: SpawnScalar, R>(
+fn with_scene<S: Scalar, R>(
     data: &SceneData<'_>,
     f: impl FnOnce(&Scene<'_, S>, Settings) -> R,
 ) -> R {
@@ -371,7 +372,7 @@ fn with_scene<S: SpawnScalar, R>(
 /// Path length 2 is direct light: on a scene without mirror or glossy surfaces, emitters seen
 /// by BSDF rays or a background, the path integrator's light samples are the direct
 /// integrator's, bit for bit (same random values, same operations). Length 3 adds light.
-fn direct_is_length_two_case<S: SpawnScalar>() {
+fn direct_is_length_two_case<S: Scalar>() {
     diffuse_cornell::<S, _>(|scene, st| {
         let st = Settings {
             width: 24,
@@ -413,7 +414,7 @@ fn direct_integrator_is_the_path_integrator_of_length_two() {
 
 /// Any tiling gives the same bits: every random value (Russian roulette's too) depends only
 /// on the pixel, the sample and the dimension.
-fn tiles_case<S: SpawnScalar>() {
+fn tiles_case<S: Scalar>() {
     with_scene::<S, _>(&scenes::CORNELL, |scene, st| {
         let st = Settings {
             width: 20,

@@ -2,7 +2,7 @@
 //! (more digits than f32 holds), so they parse to the exact bits of the failing cases.
 #![allow(clippy::excessive_precision)]
 
-use raykernel::{Ray, Triangle};
+use raykernel::{Ray, Triangle, TriangleHit};
 
 /// Long, thin, axis-flat slivers from sponza (triangles 10474 and 62480): the f32 edge
 /// functions keep too few bits for an accurate `t`, which once pushed the hit point outside
@@ -32,7 +32,7 @@ fn sponza_slivers_are_hit_with_accurate_t() {
     for (verts, dir, t_exact) in cases {
         let tri = Triangle::<f32>::from_f32(verts).unwrap();
         let ray = Ray::<f32>::from_f32([-11.0, 2.5, 0.0], dir, 0.0, f32::INFINITY).unwrap();
-        let (t, _, _) = tri
+        let TriangleHit { t, .. } = tri
             .intersect(&ray)
             .unwrap_or_else(|| panic!("missed {verts:?}"));
         assert!(
@@ -65,7 +65,7 @@ fn barycentrics_of_a_hit_stay_in_unit_interval() {
         let back = [0.0, 1e-36, 1e-30, 1e-20, 1e-3][(step & 3) as usize + (step == 0) as usize];
         let o = [-back * d[0], -back * dy, -back * d[2]];
         let ray = Ray::<f32>::from_f32(o, [d[0], dy, d[2]], 0.0, f32::INFINITY).unwrap();
-        if let Some((t, u, v)) = tri.intersect(&ray) {
+        if let Some(TriangleHit { t, u, v }) = tri.intersect(&ray) {
             hits += 1;
             assert!(t >= 0.0);
             for w in [u, v] {

@@ -14,15 +14,14 @@ use raykernel::render::{
     RenderMemory, RenderMemoryNeeded, Renderer, SamplerKind, Scene, SceneError, Settings, Shape,
     Tile, MAX_LIGHTS,
 };
-use raykernel::spawn::SpawnScalar;
 use raykernel::{
     grid::GridOptions, kdtree::KdOptions, AccelKind, AccelMemory, AnyFamily, KdNode, MemoryNeeded,
-    Node, Node4, Sphere, Triangle, I16F16,
+    Node, Node4, Scalar, Sphere, Triangle, I16F16,
 };
 use std::f64::consts::PI;
 
 /// Renders `scene` into linear RGB with a BVH (or brute force).
-fn render<S: SpawnScalar>(
+fn render<S: Scalar>(
     scene: &Scene<'_, S>,
     settings: Settings,
     accel: AccelKind,
@@ -67,7 +66,7 @@ fn cube(half: f32, x_offset: f32) -> Vec<[[f32; 3]; 3]> {
 }
 
 /// Accelerator buffers of the sizes [`memory_needed`] gives.
-struct Memory<'m, S: SpawnScalar> {
+struct Memory<'m, S: Scalar> {
     objects: Vec<ObjectSlot<'m, S>>,
     nodes: Vec<Node<S>>,
     nodes4: Vec<Node4<S>>,
@@ -75,7 +74,7 @@ struct Memory<'m, S: SpawnScalar> {
     words: Vec<u32>,
 }
 
-impl<'m, S: SpawnScalar> Memory<'m, S> {
+impl<'m, S: Scalar> Memory<'m, S> {
     fn new(scene: &Scene<'_, S>, accel: AccelKind) -> Self {
         Self::sized(memory_needed::<S, AnyFamily>(scene.objects, &accel))
     }
@@ -101,11 +100,11 @@ impl<'m, S: SpawnScalar> Memory<'m, S> {
     }
 }
 
-fn tris<S: SpawnScalar>(t: &[[[f32; 3]; 3]]) -> Vec<Triangle<S>> {
+fn tris<S: Scalar>(t: &[[[f32; 3]; 3]]) -> Vec<Triangle<S>> {
     t.iter().map(|v| Triangle::from_f32(*v).unwrap()).collect()
 }
 
-fn sphere<S: SpawnScalar>(c: [f32; 3], r: f32) -> Sphere<S> {
+fn sphere<S: Scalar>(c: [f32; 3], r: f32) -> Sphere<S> {
     Sphere {
         center: c.map(|x| S::coord_from_f32(x).unwrap()),
         radius: S::coord_from_f32(r).unwrap(),
@@ -151,7 +150,7 @@ fn rel_err(got: f32, want: f64) -> f64 {
 }
 
 /// Point light straight above the seen point: `L = ρ/π · I / h²`.
-fn point_light_case<S: SpawnScalar>() {
+fn point_light_case<S: Scalar>() {
     let t = tris::<S>(&floor(4.0));
     let objects = [Object::new(Shape::Triangles(&t), 0)];
     let (rho, intensity, h) = (0.6f32, 5.0f32, 1.5f32);
@@ -185,7 +184,7 @@ fn known_answer_point_light() {
 
 /// Sphere light of radius `r` at height `d` above the seen point: `E = π·L·(r/d)²`, so
 /// `L_out = ρ·L·(r/d)²`.
-fn sphere_light_case<S: SpawnScalar>(sampler: SamplerKind) {
+fn sphere_light_case<S: Scalar>(sampler: SamplerKind) {
     let t = tris::<S>(&floor(4.0));
     let objects = [Object::new(Shape::Triangles(&t), 0)];
     let (rho, radiance, r, d) = (0.5f32, 3.0f32, 0.5f32, 2.0f32);
@@ -229,7 +228,7 @@ fn corner_irradiance(a: f64, b: f64, h: f64) -> f64 {
     0.5 * (x / sx * (y / sx).atan() + y / sy * (x / sy).atan())
 }
 
-fn rect_light_case<S: SpawnScalar>() {
+fn rect_light_case<S: Scalar>() {
     let t = tris::<S>(&floor(4.0));
     let objects = [Object::new(Shape::Triangles(&t), 0)];
     let (rho, radiance, half, h) = (0.7f32, 2.0f32, 0.5f32, 1.0f32);
@@ -269,7 +268,7 @@ fn known_answer_rect_light() {
 /// Furnace for reflections: inside a closed emissive box of radiance `L`, a mirror of
 /// reflectance `ρ` shows exactly `ρ·L`; a glossy sphere at most `ρ·L`, and `ρ·L` wherever no
 /// lobe sample falls below the surface; with no bounces left, a mirror is black.
-fn furnace_case<S: SpawnScalar>() {
+fn furnace_case<S: Scalar>() {
     let t = tris::<S>(&cube(3.0, 0.0));
     let mirror = [sphere::<S>([0.0, 0.0, 0.0], 1.0)];
     let (rho, l) = (0.8f32, 1.5f32);
@@ -544,7 +543,7 @@ fn stratified_samples_fill_every_cell_once() {
 }
 
 /// Converts a built-in scene into the mode and hands it to `f`.
-fn with_scene<S: SpawnScalar, R>(d: &SceneData<'_>, f: impl FnOnce(&Scene<'_, S>) -> R) -> R {
+fn with_scene<S: Scalar, R>(d: &SceneData<'_>, f: impl FnOnce(&Scene<'_, S>) -> R) -> R {
     let mut t = vec![Triangle::<S>::from_f32([[0.0; 3]; 3]).unwrap(); d.triangles.len()];
     let mut s = vec![sphere::<S>([0.0; 3], 0.0); d.spheres.len()];
     d.triangles_into(&mut t).unwrap();
@@ -554,7 +553,7 @@ fn with_scene<S: SpawnScalar, R>(d: &SceneData<'_>, f: impl FnOnce(&Scene<'_, S>
     f(&scene)
 }
 
-fn tiles_equal_whole<S: SpawnScalar>(d: &SceneData<'_>) {
+fn tiles_equal_whole<S: Scalar>(d: &SceneData<'_>) {
     with_scene::<S, _>(d, |scene| {
         let st = d.settings;
         let whole = render(scene, st, AccelKind::default()).unwrap();
@@ -660,7 +659,7 @@ fn plans_follow_the_scenes() {
 /// every built-in scene made static, pinhole and one sample per pixel. (Emitters seen
 /// directly: `emitters_only_case`.)
 /// Returns how many values show the background.
-fn camera_rays_only_case<S: SpawnScalar>(d: &SceneData<'_>) -> usize {
+fn camera_rays_only_case<S: Scalar>(d: &SceneData<'_>) -> usize {
     // Every material diffuse (black without lights), and a background that is not.
     let materials = vec![Material::Diffuse { albedo: [0.5; 3] }; d.materials.len()];
     let objects: Vec<_> = d
@@ -728,7 +727,7 @@ fn camera_rays_only_loop_equals_the_general_path() {
 /// plan takes the first-hit loop whatever its lights; one diffuse sphere behind the camera,
 /// never seen, makes the plan take the general loop. Both must give the same bits.
 /// Returns how many values differ from zero and from the background.
-fn emitters_only_case<S: SpawnScalar>(d: &SceneData<'_>) -> usize {
+fn emitters_only_case<S: Scalar>(d: &SceneData<'_>) -> usize {
     let materials: Vec<Material> = (0..d.materials.len())
         .map(|i| Material::Emissive {
             radiance: [0.3 + 0.1 * i as f32, 0.5, 0.9 - 0.1 * i as f32],
@@ -1180,7 +1179,7 @@ fn buffers_and_tiles_are_checked_exactly() {
 /// Rays leaving sphere surfaces (outward reflections and shadow rays) never hit their own
 /// sphere again: a camera ray grazing a grid of spheres at several scales sees no acne, i.e.
 /// a mirror sphere in an emissive box is `ρ·L` on every pixel it covers.
-fn no_sphere_acne<S: SpawnScalar>(scale: f32, offset: f32) {
+fn no_sphere_acne<S: Scalar>(scale: f32, offset: f32) {
     let t = tris::<S>(&cube(3.0 * scale, offset));
     let sp = [sphere::<S>([offset, 0.0, 0.0], scale)];
     let objects = [

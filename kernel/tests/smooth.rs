@@ -8,8 +8,7 @@ mod common;
 use raykernel::render::{
     Camera, Item, Light, Material, Object, Problem, Scene, SceneError, Settings, Shape,
 };
-use raykernel::spawn::SpawnScalar;
-use raykernel::{Triangle, I16F16};
+use raykernel::{Scalar, Triangle, I16F16};
 
 /// The floor: one triangle in `y = 0` whose corners are chosen so the origin has barycentrics
 /// `(u, v) = (1/4, 1/4)`; its winding makes the geometric normal point down (`-y`).
@@ -19,10 +18,7 @@ const INTENSITY: f32 = 4.0;
 
 /// The linear radiance of the one pixel of a 1×1, 1-sample render looking straight down at the
 /// origin from `(0, 1, 0)`, the floor lit by a point light at `light`.
-fn pixel<S: SpawnScalar>(
-    normals: &[[[f32; 3]; 3]],
-    light: [f32; 3],
-) -> Result<[f32; 3], SceneError> {
+fn pixel<S: Scalar>(normals: &[[[f32; 3]; 3]], light: [f32; 3]) -> Result<[f32; 3], SceneError> {
     let floor = [Triangle::<S>::from_f32(FLOOR).unwrap()];
     let objects = [Object {
         vertex_normals: normals,
@@ -80,7 +76,7 @@ fn tilted() -> [f32; 3] {
     [h, h, 0.0]
 }
 
-fn known_answers<S: SpawnScalar>() {
+fn known_answers<S: Scalar>() {
     let above = [0.0, 2.0, 0.0];
     let up = [0.0, 1.0, 0.0];
     // No normals: flat, cosine 1.
@@ -123,7 +119,7 @@ fn shading_normal_is_the_blend_of_the_corner_normals_fixed() {
 
 /// A light below the floor's plane: the tilted shading normal faces it, but a shadow ray
 /// towards it would leave through the back of the surface, so it adds nothing.
-fn light_behind_the_surface<S: SpawnScalar>() {
+fn light_behind_the_surface<S: Scalar>() {
     let below = [5.0, -0.5, 0.0];
     let n = [1.0, 0.1, 0.0];
     assert_eq!(pixel::<S>(&[[n; 3]], below).unwrap(), [0.0; 3]);

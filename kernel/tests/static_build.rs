@@ -166,7 +166,7 @@ fn static_family_renders_the_default_bytes() {
     use raykernel::BvhFamily;
     use raykernel_testkit::golden::{render_hash, render_hash_with, Bits, EMITTERS};
 
-    fn check<S: Bits + raykernel::spawn::SpawnScalar>() {
+    fn check<S: Bits + raykernel::Scalar>() {
         for data in [scenes::CORNELL, scenes::SPHERES, scenes::MOTION, EMITTERS] {
             let want = render_hash::<S>(&data).unwrap();
             let got = render_hash_with::<S, BvhFamily<StaticBuild<Sah, false>>, AllFeatures>(

@@ -14,11 +14,11 @@ mod common;
 
 use common::{hit_bits, TestScalar};
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
-use raykernel::spawn::{offset_origin, spawn_ray, spawn_shadow_ray, SpawnScalar};
+use raykernel::spawn::{offset_origin, spawn_ray, spawn_shadow_ray};
 use raykernel::{
     grid::GridOptions, kdtree::KdOptions, Aabb, Accel, AccelKind, AccelVisitor, AnyAccel, Arena,
-    BuildError, Bvh, Hit, Linear, Node, PointError, Primitive, Ray, RayData, RayError, Scalar,
-    Triangle, Vec3x, I16F16,
+    Barycentrics, BuildError, Bvh, Hit, Linear, Node, PointError, Primitive, Ray, RayData,
+    RayError, Scalar, Triangle, Vec3x, VertexError, I16F16,
 };
 use raykernel_testkit::icosphere::unit_icosphere;
 use raykernel_testkit::memory::OwnedMemory;
@@ -165,8 +165,8 @@ fn table_markdown(t: &Table) -> String {
 // ---------------------------------------------------------------------------------------------
 // Number modes.
 
-/// What the suite needs from a mode on top of the shared test helpers and the spawn rule.
-trait Mode: TestScalar + SpawnScalar {
+/// What the suite needs from a mode on top of the shared test helpers.
+trait Mode: TestScalar {
     const COLUMN: &'static str;
     /// Rounds a coordinate to the mode (the caller keeps it in range).
     fn from_f64(x: f64) -> Self;
@@ -212,7 +212,7 @@ impl Mode for I16F16 {
 }
 
 fn to_f64<S: Mode>(p: [S; 3]) -> [f64; 3] {
-    p.map(SpawnScalar::to_f64)
+    p.map(Scalar::to_f64)
 }
 
 fn tri_normal<S: Mode>(t: &Triangle<S>) -> [f64; 3] {
@@ -264,7 +264,7 @@ impl Primitive<f32> for MtTri {
     fn bounds(&self) -> Aabb<f32> {
         self.0.bounds()
     }
-    fn check(&self) -> Result<(), (usize, PointError)> {
+    fn check(&self) -> Result<(), VertexError> {
         self.0.check()
     }
     fn hit_t(&self, ray: &RayData<f32>, t_min: f32, t_max: f32) -> Option<f32> {
@@ -272,8 +272,8 @@ impl Primitive<f32> for MtTri {
         let d = <f32 as Scalar>::ray_dir(ray);
         mt_t(o, d, &self.0.v, t_min, t_max)
     }
-    fn hit_uv(&self, _ray: &RayData<f32>) -> (f32, f32) {
-        (0.0, 0.0)
+    fn hit_uv(&self, _ray: &RayData<f32>) -> Barycentrics<f32> {
+        Barycentrics::ZERO
     }
 }
 
@@ -409,7 +409,7 @@ fn bunny() -> Option<Mesh> {
         let ray = Ray::<f32>::from_f32(o, d, 0.0, f32::INFINITY).unwrap();
         let mut h: Vec<f32> = tris
             .iter()
-            .filter_map(|t| t.intersect(&ray).map(|x| x.0))
+            .filter_map(|t| t.intersect(&ray).map(|x| x.t))
             .collect();
         h.sort_by(f32::total_cmp);
         h
@@ -719,7 +719,7 @@ fn watertight<S: Mode>(meshes: &[Mesh]) {
                     // A point on the rounded edge, rounded again: as close to it as the mode
                     // can aim.
                     let p = [0, 1, 2].map(|k| {
-                        let (x, y) = (SpawnScalar::to_f64(va[k]), SpawnScalar::to_f64(vb[k]));
+                        let (x, y) = (Scalar::to_f64(va[k]), Scalar::to_f64(vb[k]));
                         S::from_f64(x + (y - x) * s)
                     });
                     targets[1].push(([0, 1, 2].map(|k| ma[k] + (mb[k] - ma[k]) * s), p));
@@ -1146,9 +1146,9 @@ fn spawned<S: Mode>(meshes: &[Mesh]) {
                 let gt = placed.tris[g];
                 let (ga, gb) = (S::from_f64(f64::from(a)), S::from_f64(f64::from(b)));
                 let ht = to_f64(S::vec_to_array(ray.origin()));
-                let hp = [0, 1, 2].map(|k| ht[k] + SpawnScalar::to_f64(hit.t) * d[k]);
+                let hp = [0, 1, 2].map(|k| ht[k] + Scalar::to_f64(hit.t) * d[k]);
                 let gv = gt.v.map(to_f64::<S>);
-                let (af, bf) = (SpawnScalar::to_f64(ga), SpawnScalar::to_f64(gb));
+                let (af, bf) = (Scalar::to_f64(ga), Scalar::to_f64(gb));
                 let gq = [0, 1, 2]
                     .map(|k| gv[0][k] + af * (gv[1][k] - gv[0][k]) + bf * (gv[2][k] - gv[0][k]));
                 // Offset the target toward the shading point's *offset* origin: the raw hit
@@ -1194,8 +1194,7 @@ fn spawned<S: Mode>(meshes: &[Mesh]) {
             }
             // Informational: the reflection ray from the unmodified hit point o + t·d.
             let hp = [0, 1, 2].map(|k| {
-                SpawnScalar::to_f64(S::vec_to_array(ray.origin())[k])
-                    + SpawnScalar::to_f64(hit.t) * d[k]
+                Scalar::to_f64(S::vec_to_array(ray.origin())[k]) + Scalar::to_f64(hit.t) * d[k]
             });
             let ho = hp.map(S::from_f64);
             if let Ok(nr) = S::ray_along(ho, r) {
@@ -1459,7 +1458,7 @@ fn bad_input<S: Mode>() {
                     PointError::NonFinite
                 };
                 check(format!("vertex {k} axis {j} = {x}"), &|| {
-                    Triangle::<S>::from_f32(v) == Err((k, expect))
+                    Triangle::<S>::from_f32(v) == Err(VertexError::new(k, expect))
                 });
                 // The builder must name the same vertex when handed unchecked data (f32 only:
                 // fixed point cannot hold such values).

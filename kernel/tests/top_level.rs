@@ -9,15 +9,14 @@ use raykernel::render::{
     memory_needed, Camera, Light, Material, Object, ObjectSlot, RenderMemory, Renderer, Scene,
     Settings, Shape,
 };
-use raykernel::spawn::SpawnScalar;
 use raykernel::{
     AccelFamily, AccelKind, AccelMemory, AnyFamily, BvhFamily, KdNode, LinearFamily, Node, Node4,
-    Sphere, I16F16,
+    Scalar, Sphere, I16F16,
 };
 use raykernel_testkit::Rng;
 
 /// `n` small spheres scattered in a box in front of the camera (some overlapping).
-fn spheres<S: SpawnScalar>(n: usize, seed: u64) -> Vec<Sphere<S>> {
+fn spheres<S: Scalar>(n: usize, seed: u64) -> Vec<Sphere<S>> {
     let mut rng = Rng::new(seed);
     (0..n)
         .map(|_| {
@@ -37,10 +36,7 @@ fn spheres<S: SpawnScalar>(n: usize, seed: u64) -> Vec<Sphere<S>> {
 
 /// The sRGB bytes of `objects` rendered with family `F` and `options`, lit by one point light
 /// (so shadow rays run the any-hit walk too).
-fn render<S: SpawnScalar, F: AccelFamily<S>>(
-    objects: &[Object<'_, S>],
-    options: F::Options,
-) -> Vec<u8> {
+fn render<S: Scalar, F: AccelFamily<S>>(objects: &[Object<'_, S>], options: F::Options) -> Vec<u8> {
     let materials = [Material::Diffuse {
         albedo: [0.8, 0.7, 0.6],
     }];
@@ -91,7 +87,7 @@ fn render<S: SpawnScalar, F: AccelFamily<S>>(
     out
 }
 
-fn many_objects_equal_one_object<S: SpawnScalar>() {
+fn many_objects_equal_one_object<S: Scalar>() {
     let all = spheres::<S>(300, 0x5EED);
     // One object per sphere, with empty objects between some of them (no ids of their own).
     let mut many = Vec::new();

@@ -8,7 +8,7 @@
 mod common;
 
 use common::{c, dir_to, p, RaySpec, TestScalar};
-use raykernel::{Primitive, Sphere, Triangle, I16F16};
+use raykernel::{Primitive, Sphere, Triangle, TriangleHit, I16F16};
 use raykernel_testkit::vec3::{cross, dot, normalize, sub};
 use raykernel_testkit::Rng;
 
@@ -56,7 +56,12 @@ fn expect_hit<S: TestScalar>(
             ctx()
         );
     }
-    let Some((ht, hu, hv)) = t.intersect(&r.ray::<S>()) else {
+    let Some(TriangleHit {
+        t: ht,
+        u: hu,
+        v: hv,
+    }) = t.intersect(&r.ray::<S>())
+    else {
         panic!("{}: missed, want a hit at {exact:?}", ctx());
     };
     let got = (ht.to_f32() as f64, hu.to_f32() as f64, hv.to_f32() as f64);
@@ -351,7 +356,7 @@ fn interval_cases<S: TestScalar>() {
         if hits {
             expect_hit(&t, r, Some((4.0, 0.25, 0.25)), "interval");
             assert_eq!(
-                t.intersect(&r.ray::<S>()).unwrap().0,
+                t.intersect(&r.ray::<S>()).unwrap().t,
                 c::<S>(4.0),
                 "{} t exact, ray {r}",
                 S::NAME

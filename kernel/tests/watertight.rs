@@ -490,7 +490,7 @@ fn all_hits(tris: &[Triangle<f32>], r: RaySpec) -> Vec<f32> {
     let mut out: Vec<f32> = tris
         .iter()
         .filter_map(|t| t.intersect(&ray))
-        .map(|h| h.0)
+        .map(|h| h.t)
         .collect();
     out.sort_by(f32::total_cmp);
     out

@@ -14,7 +14,6 @@ use raykernel::render::{
     AllFeatures, Camera, Filter, Integrator, Material, Object, ObjectSlot, Problem, RenderFeatures,
     RenderMemory, Renderer, SamplerKind, Settings, Shape, Tile,
 };
-use raykernel::spawn::SpawnScalar;
 use raykernel::{
     Accel, AccelFamily, AccelMemory, Bvh, BvhFamily, Hit, Linear, Node, Primitive, Ray, Scalar,
     Sphere, Triangle, I16F16,
@@ -488,7 +487,7 @@ const RENDER_WIDTH: usize = 64;
 /// (so the M0 needs no framebuffer), and hashes the 8-bit sRGB bytes in row-major order: the
 /// same value as FNV-1a over the whole image's bytes.
 #[inline(never)] // one case's buffers on the stack at a time (the M0 has 16 KB of RAM)
-pub fn render_hash<S: Bits + SpawnScalar>(data: &SceneData<'_>) -> Result<u64, Fail> {
+pub fn render_hash<S: Bits + Scalar>(data: &SceneData<'_>) -> Result<u64, Fail> {
     render_hash_with::<S, BvhFamily, AllFeatures>(data, BuildOptions::default())
 }
 
@@ -496,7 +495,7 @@ pub fn render_hash<S: Bits + SpawnScalar>(data: &SceneData<'_>) -> Result<u64, F
 /// with `options`, by a renderer linking the parts `K` names: every family gives the same
 /// bytes, and so does every `K` that links what the scene needs (else [`Fail::NotLinked`]).
 #[inline(never)]
-pub fn render_hash_with<S: Bits + SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub fn render_hash_with<S: Bits + Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     data: &SceneData<'_>,
     options: F::Options,
 ) -> Result<u64, Fail> {

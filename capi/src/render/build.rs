@@ -12,8 +12,7 @@ use raykernel::render::{
     memory_needed, Camera, Filter, Light, Material, Object, ObjectSlot, RenderMemory, Renderer,
     SamplerKind, Scene, Settings, Shape,
 };
-use raykernel::spawn::SpawnScalar;
-use raykernel::{AccelFamily, AccelMemory, Node, Node4, Sphere, Triangle};
+use raykernel::{AccelFamily, AccelMemory, Node, Node4, Scalar, Sphere, Triangle};
 
 /// Alignment of the start of the laid-out memory (the 4-wide BVH's nodes need 128).
 pub(super) const ALIGN: usize = 128;
@@ -48,7 +47,7 @@ impl Cursor {
     }
 }
 
-pub(super) fn layout<S: SpawnScalar, F: AccelFamily<S>>(c: &Counts) -> Option<Layout> {
+pub(super) fn layout<S: Scalar, F: AccelFamily<S>>(c: &Counts) -> Option<Layout> {
     let mut at = Cursor(0);
     let state = at.place::<Renderer<'static, S, F>>(1)?;
     debug_assert_eq!(state, 0);
@@ -110,7 +109,7 @@ unsafe fn filled<T: Copy>(at: *mut u8, count: usize, value: T) -> &'static mut [
     unsafe { core::slice::from_raw_parts_mut(p, count) }
 }
 
-fn init_in<S: SpawnScalar, F: AccelFamily<S, Options = BuildOptions>>(
+fn init_in<S: Scalar, F: AccelFamily<S, Options = BuildOptions>>(
     view: &View<'_>,
     counts: &Counts,
     memory: *mut u8,
@@ -235,7 +234,7 @@ fn init_in<S: SpawnScalar, F: AccelFamily<S, Options = BuildOptions>>(
 }
 
 /// Converts every object's floats into the mode, triangles and spheres in scene order.
-fn convert_primitives<S: SpawnScalar>(
+fn convert_primitives<S: Scalar>(
     view: &View<'_>,
     tris: &mut [Triangle<S>],
     spheres: &mut [Sphere<S>],
@@ -262,7 +261,7 @@ fn convert_primitives<S: SpawnScalar>(
 }
 
 /// A sphere from centre x y z and radius: finite, in the mode's range, radius not negative.
-fn sphere<S: SpawnScalar>(c: &[f32]) -> Option<Sphere<S>> {
+fn sphere<S: Scalar>(c: &[f32]) -> Option<Sphere<S>> {
     let mut center = [S::ZERO; 3];
     for (slot, x) in center.iter_mut().zip(c) {
         *slot = S::coord_from_f32(*x).ok()?;

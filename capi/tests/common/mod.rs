@@ -9,8 +9,7 @@ use raykernel::render::{
     memory_needed, Camera, Filter, Light, Material, Object, ObjectSlot, RenderMemory, Renderer,
     Rgb, SamplerKind, Scene, Settings, Shape,
 };
-use raykernel::spawn::SpawnScalar;
-use raykernel::{AccelMemory, Bvh4Family, Node, Node4, Sphere, Triangle};
+use raykernel::{AccelMemory, Bvh4Family, Node, Node4, Scalar, Sphere, Triangle};
 use raykernel_c::*;
 
 /// An object's primitives as `f32` data.
@@ -136,13 +135,13 @@ pub fn fnv1a(bytes: &[u8]) -> u32 {
 }
 
 /// One object's primitives converted to mode `S`.
-enum Prims<S: SpawnScalar> {
+enum Prims<S: Scalar> {
     Triangles(Vec<Triangle<S>>),
     Spheres(Vec<Sphere<S>>),
 }
 
 /// The kernel's render of `data` (4-wide BVHs), whole image, sRGB.
-pub fn kernel_render<S: SpawnScalar>(data: &TestScene) -> Vec<u8> {
+pub fn kernel_render<S: Scalar>(data: &TestScene) -> Vec<u8> {
     let coord = |x: f32| S::coord_from_f32(x).expect("the test scene is in range");
     let prims: Vec<Prims<S>> = data
         .objects

@@ -8,7 +8,7 @@ use super::grid::{Grid, InvalidGrid};
 use super::kdtree::{InvalidKdTree, KdTree};
 use super::memory::take;
 use super::{Accel, AccelKind, AccelMemory, BuildError, Counters, Linear, MemoryNeeded, Nearest};
-use crate::geom::{Primitive, Ray};
+use crate::geom::{Barycentrics, Primitive, Ray};
 use crate::scalar::Scalar;
 
 /// A built accelerator of any kind. Its queries return what the structure inside returns.
@@ -219,7 +219,7 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for AnyAccel<'_, S, P> {
     }
 
     #[inline]
-    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
+    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> Barycentrics<S> {
         match self {
             Self::Linear(a) => a.barycentrics(ray, found),
             Self::Bvh(a) => a.barycentrics(ray, found),

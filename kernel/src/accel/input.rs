@@ -23,12 +23,11 @@ pub(crate) const fn check_count(count: usize) -> Result<(), BuildError> {
 /// rejects.
 pub(crate) fn check_each<S: Scalar, P: Primitive<S>>(prims: &[P]) -> Result<(), BuildError> {
     for (prim, p) in prims.iter().enumerate() {
-        p.check()
-            .map_err(|(vertex, error)| BuildError::BadPrimitive {
-                prim,
-                vertex,
-                error,
-            })?;
+        p.check().map_err(|e| BuildError::BadPrimitive {
+            prim,
+            vertex: e.vertex,
+            error: e.error,
+        })?;
     }
     Ok(())
 }

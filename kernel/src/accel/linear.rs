@@ -1,5 +1,5 @@
 use super::{Accel, Counters, Nearest};
-use crate::geom::{closer, Primitive, Ray};
+use crate::geom::{closer, Barycentrics, Primitive, Ray};
 use crate::scalar::Scalar;
 use core::marker::PhantomData;
 
@@ -40,7 +40,7 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for Linear<'_, S, P> {
         })
     }
 
-    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
+    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> Barycentrics<S> {
         found.barycentrics_in(self.prims, ray)
     }
 

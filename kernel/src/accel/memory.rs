@@ -70,6 +70,17 @@ pub struct MemoryNeeded {
     pub words: usize,
 }
 
+/// A buffer shorter than required, as [`MemoryNeeded::first_shortfall`] finds it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shortfall {
+    /// The [`MemoryNeeded`] field naming the buffer: `nodes`, `nodes4`, `kd_nodes` or `words`.
+    pub field: &'static str,
+    /// Length required.
+    pub needed: usize,
+    /// Length available.
+    pub available: usize,
+}
+
 impl MemoryNeeded {
     /// Nothing.
     pub const NONE: Self = Self {
@@ -139,13 +150,9 @@ impl MemoryNeeded {
             .saturating_add(self.words.saturating_mul(4))
     }
 
-    /// The first buffer shorter in `available` than required here: its field name, the
-    /// length needed and the length available.
+    /// The first buffer shorter in `available` than required here.
     #[must_use]
-    pub const fn first_shortfall(
-        &self,
-        available: &MemoryNeeded,
-    ) -> Option<(&'static str, usize, usize)> {
+    pub const fn first_shortfall(&self, available: &MemoryNeeded) -> Option<Shortfall> {
         let pairs = [
             ("nodes", self.nodes, available.nodes),
             ("nodes4", self.nodes4, available.nodes4),
@@ -154,9 +161,13 @@ impl MemoryNeeded {
         ];
         let mut i = 0;
         while i < pairs.len() {
-            let (field, needed, have) = pairs[i];
-            if have < needed {
-                return Some((field, needed, have));
+            let (field, needed, available) = pairs[i];
+            if available < needed {
+                return Some(Shortfall {
+                    field,
+                    needed,
+                    available,
+                });
             }
             i += 1;
         }

@@ -28,9 +28,9 @@ pub(crate) use input::{check_count, check_each};
 pub use kind::{AccelKind, UnknownAccel};
 pub use linear::Linear;
 pub(crate) use memory::take;
-pub use memory::{AccelMemory, MemoryNeeded};
+pub use memory::{AccelMemory, MemoryNeeded, Shortfall};
 
-use crate::geom::{Hit, Primitive, Ray};
+use crate::geom::{Barycentrics, Hit, Primitive, Ray};
 use crate::scalar::Scalar;
 
 /// Traversal counters, for benchmarks. The [`NoStats`] implementation compiles to nothing.
@@ -97,10 +97,14 @@ impl<S: Scalar> Nearest<S> {
     /// Barycentrics of this hit on `prims[slot]` (zero if the slot is out of range, which a
     /// hit of the accelerator owning `prims` never is).
     #[inline]
-    pub(crate) fn barycentrics_in<P: Primitive<S>>(&self, prims: &[P], ray: &Ray<S>) -> (S, S) {
+    pub(crate) fn barycentrics_in<P: Primitive<S>>(
+        &self,
+        prims: &[P],
+        ray: &Ray<S>,
+    ) -> Barycentrics<S> {
         prims
             .get(self.slot)
-            .map_or((S::ZERO, S::ZERO), |p| p.hit_uv(ray.data()))
+            .map_or(Barycentrics::ZERO, |p| p.hit_uv(ray.data()))
     }
 }
 
@@ -115,13 +119,13 @@ pub trait Accel<S: Scalar> {
     /// Any hit, counting work in `stats`.
     fn occluded_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> bool;
     /// Barycentrics of a hit `nearest` returned for `ray` (zero for primitives without them).
-    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S);
+    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> Barycentrics<S>;
 
     /// Closest hit with barycentrics, counting work in `stats`.
     #[inline]
     fn intersect_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Hit<S>> {
         let found = self.nearest_counted(ray, stats)?;
-        let (u, v) = self.barycentrics(ray, &found);
+        let Barycentrics { u, v } = self.barycentrics(ray, &found);
         Some(Hit {
             t: found.t,
             prim: found.prim,

@@ -8,6 +8,6 @@ pub mod spawn;
 
 pub(crate) use aabb::corners_contain;
 pub use aabb::Aabb;
-pub use hit::{closer, Hit};
-pub use primitive::{Primitive, Sphere, Triangle};
+pub use hit::{closer, Barycentrics, Hit, TriangleHit};
+pub use primitive::{Primitive, Sphere, Triangle, VertexError};
 pub use ray::Ray;

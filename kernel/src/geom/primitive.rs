@@ -1,6 +1,34 @@
-use super::{Aabb, Ray};
+use super::{Aabb, Barycentrics, Ray, TriangleHit};
 use crate::scalar::PointError;
 use crate::scalar::Scalar;
+use core::fmt;
+
+/// An unusable vertex (or field) of a primitive: its index within the primitive (0..3 for
+/// triangles; 0 = centre, 1 = radius for spheres) and what is wrong with it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct VertexError {
+    /// Index of the vertex (or field) within the primitive.
+    pub vertex: usize,
+    /// What is wrong with it.
+    pub error: PointError,
+}
+
+impl VertexError {
+    /// Vertex (or field) `vertex` is unusable for the reason `error`.
+    #[must_use]
+    pub const fn new(vertex: usize, error: PointError) -> Self {
+        Self { vertex, error }
+    }
+}
+
+impl fmt::Display for VertexError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "vertex {}: {}", self.vertex, self.error)
+    }
+}
+
+impl core::error::Error for VertexError {}
 
 /// Something an accelerator can hold: it has bounds and a pure intersection test. Plain data
 /// (`Copy`), so built structures over it are `Copy` too.
@@ -10,12 +38,15 @@ use crate::scalar::Scalar;
 pub trait Primitive<S: Scalar>: Copy + core::fmt::Debug {
     /// A box holding the primitive.
     fn bounds(&self) -> Aabb<S>;
-    /// Checks the primitive's data. On error, the index of the bad vertex (or field).
-    fn check(&self) -> Result<(), (usize, PointError)>;
+    /// Checks the primitive's data.
+    ///
+    /// # Errors
+    /// The first unusable vertex (or field).
+    fn check(&self) -> Result<(), VertexError>;
     /// Distance of a hit within `[t_min, t_max]`, if any.
     fn hit_t(&self, ray: &S::RayData, t_min: S, t_max: S) -> Option<S>;
     /// Barycentrics of a hit reported by `hit_t` (zero for primitives without them).
-    fn hit_uv(&self, ray: &S::RayData) -> (S, S);
+    fn hit_uv(&self, ray: &S::RayData) -> Barycentrics<S>;
 }
 
 /// A two-sided triangle. Degenerate ones (zero area) are accepted and never hit.
@@ -36,22 +67,22 @@ impl<S: Scalar> Triangle<S> {
     /// From `f32` vertices, converting each coordinate.
     ///
     /// # Errors
-    /// The index of the first bad vertex and what is wrong with it.
-    pub fn from_f32(v: [[f32; 3]; 3]) -> Result<Self, (usize, PointError)> {
+    /// The first unusable vertex.
+    pub fn from_f32(v: [[f32; 3]; 3]) -> Result<Self, VertexError> {
         let mut out = [[S::ZERO; 3]; 3];
         for (i, p) in v.iter().enumerate() {
             for k in 0..3 {
-                out[i][k] = S::coord_from_f32(p[k]).map_err(|e| (i, e))?;
+                out[i][k] = S::coord_from_f32(p[k]).map_err(|e| VertexError::new(i, e))?;
             }
         }
         Ok(Self { v: out })
     }
 
     /// Closest-hit test for this triangle alone: distance and barycentrics.
-    pub fn intersect(&self, ray: &Ray<S>) -> Option<(S, S, S)> {
+    pub fn intersect(&self, ray: &Ray<S>) -> Option<TriangleHit<S>> {
         let t = self.hit_t(ray.data(), ray.t_min(), ray.t_max())?;
-        let (u, v) = self.hit_uv(ray.data());
-        Some((t, u, v))
+        let Barycentrics { u, v } = self.hit_uv(ray.data());
+        Some(TriangleHit { t, u, v })
     }
 }
 
@@ -66,9 +97,9 @@ impl<S: Scalar> Primitive<S> for Triangle<S> {
         }
         r
     }
-    fn check(&self) -> Result<(), (usize, PointError)> {
+    fn check(&self) -> Result<(), VertexError> {
         for (i, p) in self.v.iter().enumerate() {
-            S::check_point(*p).map_err(|e| (i, e))?;
+            S::check_point(*p).map_err(|e| VertexError::new(i, e))?;
         }
         Ok(())
     }
@@ -76,8 +107,9 @@ impl<S: Scalar> Primitive<S> for Triangle<S> {
     fn hit_t(&self, ray: &S::RayData, t_min: S, t_max: S) -> Option<S> {
         S::triangle_t(ray, &self.v, t_min, t_max)
     }
-    fn hit_uv(&self, ray: &S::RayData) -> (S, S) {
-        S::triangle_uv(ray, &self.v)
+    fn hit_uv(&self, ray: &S::RayData) -> Barycentrics<S> {
+        let (u, v) = S::triangle_uv(ray, &self.v);
+        Barycentrics { u, v }
     }
 }
 
@@ -105,19 +137,19 @@ impl<S: Scalar> Primitive<S> for Sphere<S> {
         let (lo, hi) = S::sphere_bounds(&self.center, self.radius);
         Aabb::new(lo, hi)
     }
-    fn check(&self) -> Result<(), (usize, PointError)> {
-        S::check_point(self.center).map_err(|e| (0, e))?;
-        S::check_radius(self.radius).map_err(|e| (1, e))?;
+    fn check(&self) -> Result<(), VertexError> {
+        S::check_point(self.center).map_err(|e| VertexError::new(0, e))?;
+        S::check_radius(self.radius).map_err(|e| VertexError::new(1, e))?;
         let b = self.bounds();
         S::check_point(b.lo)
             .and(S::check_point(b.hi))
-            .map_err(|e| (1, e))
+            .map_err(|e| VertexError::new(1, e))
     }
     #[inline(always)]
     fn hit_t(&self, ray: &S::RayData, t_min: S, t_max: S) -> Option<S> {
         S::sphere_t(ray, &self.center, self.radius, t_min, t_max)
     }
-    fn hit_uv(&self, _ray: &S::RayData) -> (S, S) {
-        (S::ZERO, S::ZERO)
+    fn hit_uv(&self, _ray: &S::RayData) -> Barycentrics<S> {
+        Barycentrics::ZERO
     }
 }

@@ -5,7 +5,8 @@
 //! (`OffsetRayOrigin`, *Physically Based Rendering* 4th ed. §6.8.6): move the origin off the
 //! triangle's plane, along its geometric normal, to the side the new direction points to, by
 //! more than the error of the hit point and of the triangle test. It is written once for both
-//! number modes and uses no allocation.
+//! number modes, generic over [`Scalar`], whose sealed per-mode numerics hold the rounding, the
+//! side test and the unit steps below; it uses no allocation.
 //!
 //! # The rule and its bound
 //!
@@ -41,8 +42,7 @@
 //! these functions on arbitrary scenes.
 
 use super::{Hit, Ray, Triangle};
-use crate::scalar::RayError;
-use crate::scalar::{Scalar, I16F16};
+use crate::scalar::{RayError, Scalar};
 
 /// Relative offset of the `f32` rule: the origin moves `2^-16·M` off the plane.
 pub const F32_SPAWN_OFFSET: f64 = 1.0 / 65536.0;
@@ -52,117 +52,6 @@ pub const FIXED_SPAWN_OFFSET_RAW: i32 = 2;
 pub const SHADOW_SHORTEN: f64 = 1.0 / 1_048_576.0;
 /// Most unit steps the side check may take.
 pub const MAX_NUDGES: u32 = 64;
-
-mod sealed {
-    pub trait Sealed {}
-    impl Sealed for f32 {}
-    impl Sealed for crate::I16F16 {}
-}
-
-/// The per-mode arithmetic of the spawn rule. Implemented for `f32` and [`I16F16`].
-pub trait SpawnScalar: Scalar + sealed::Sealed {
-    /// Exact conversion to `f64`.
-    fn to_f64(self) -> f64;
-    /// A point rounded to the nearest representable one (saturating at the mode's range).
-    fn point_from_f64(p: [f64; 3]) -> [Self; 3];
-    /// Offset distance for a triangle and hit point of largest coordinate magnitude `m`.
-    fn offset(m: f64) -> f64;
-    /// Sign of `n·(p − v0)` with `n = (v1−v0)×(v2−v0)`: exact in fixed point, `f64` for `f32`.
-    fn side(v: &[[Self; 3]; 3], p: &[Self; 3]) -> i32;
-    /// `x` moved one unit (ulp or raw) up or down.
-    fn step(x: Self, up: bool) -> Self;
-    /// A distance rounded toward zero to this mode, with `extra` further units taken off
-    /// (never below zero).
-    fn t_down(t: f64, extra: u32) -> Self;
-}
-
-impl SpawnScalar for f32 {
-    fn to_f64(self) -> f64 {
-        f64::from(self)
-    }
-    fn point_from_f64(p: [f64; 3]) -> [f32; 3] {
-        p.map(|x| x as f32)
-    }
-    fn offset(m: f64) -> f64 {
-        m * F32_SPAWN_OFFSET + f64::from(f32::MIN_POSITIVE)
-    }
-    fn side(v: &[[f32; 3]; 3], p: &[f32; 3]) -> i32 {
-        let f = |a: &[f32; 3]| a.map(f64::from);
-        let n = normal_f64(&[f(&v[0]), f(&v[1]), f(&v[2])]);
-        let d = sub(&f(p), &f(&v[0]));
-        sign(dot(&n, &d))
-    }
-    fn step(x: f32, up: bool) -> f32 {
-        if !x.is_finite() {
-            return x;
-        }
-        if x == 0.0 {
-            let tiny = f32::from_bits(1);
-            return if up { tiny } else { -tiny };
-        }
-        let bits = x.to_bits();
-        f32::from_bits(if (x > 0.0) == up { bits + 1 } else { bits - 1 })
-    }
-    fn t_down(t: f64, extra: u32) -> f32 {
-        let mut r = t as f32;
-        if f64::from(r) > t {
-            r = <f32 as SpawnScalar>::step(r, false);
-        }
-        for _ in 0..extra {
-            r = <f32 as SpawnScalar>::step(r, false);
-        }
-        if r > 0.0 {
-            r
-        } else {
-            0.0
-        }
-    }
-}
-
-impl SpawnScalar for I16F16 {
-    fn to_f64(self) -> f64 {
-        f64::from(self.raw()) / 65536.0
-    }
-    fn point_from_f64(p: [f64; 3]) -> [I16F16; 3] {
-        p.map(|x| {
-            let r = libm::round(x * 65536.0);
-            // `as` saturates (and maps NaN to 0).
-            I16F16::from_raw(r as i32)
-        })
-    }
-    fn offset(_m: f64) -> f64 {
-        f64::from(FIXED_SPAWN_OFFSET_RAW) / 65536.0
-    }
-    fn side(v: &[[I16F16; 3]; 3], p: &[I16F16; 3]) -> i32 {
-        let r = |a: &[I16F16; 3]| a.map(|x| i128::from(x.raw()));
-        let (a, b, c, q) = (r(&v[0]), r(&v[1]), r(&v[2]), r(p));
-        let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        // |e| < 2^32, |n| < 2^65, |q − a| < 2^32: the dot product stays below 2^99.
-        let n = [
-            e1[1] * e2[2] - e1[2] * e2[1],
-            e1[2] * e2[0] - e1[0] * e2[2],
-            e1[0] * e2[1] - e1[1] * e2[0],
-        ];
-        let s = n[0] * (q[0] - a[0]) + n[1] * (q[1] - a[1]) + n[2] * (q[2] - a[2]);
-        match s {
-            0 => 0,
-            s if s > 0 => 1,
-            _ => -1,
-        }
-    }
-    fn step(x: I16F16, up: bool) -> I16F16 {
-        I16F16::from_raw(if up {
-            x.raw().saturating_add(1)
-        } else {
-            x.raw().saturating_sub(1)
-        })
-    }
-    fn t_down(t: f64, extra: u32) -> I16F16 {
-        let raw = libm::floor(t * 65536.0) - f64::from(extra);
-        I16F16::from_raw(if raw > 0.0 { raw as i32 } else { 0 })
-    }
-}
 
 pub(crate) fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
@@ -195,6 +84,11 @@ fn normal_f64(v: &[[f64; 3]; 3]) -> [f64; 3] {
     cross(&sub(&v[1], &v[0]), &sub(&v[2], &v[0]))
 }
 
+/// Sign of `n·(p − v0)` with `n = (v1−v0)×(v2−v0)`, in `f64`.
+pub(crate) fn side_f64(v: &[[f64; 3]; 3], p: &[f64; 3]) -> i32 {
+    sign(dot(&normal_f64(v), &sub(p, &v[0])))
+}
+
 /// `v / |v|`, scaled first so tiny and huge vectors normalise; `None` for zero or non-finite.
 pub(crate) fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
     let m = libm::fmax(
@@ -224,7 +118,7 @@ fn max_abs(m: f64, p: &[f64; 3]) -> f64 {
 /// [module docs](self). For a degenerate triangle (no normal) the point is moved along
 /// `toward` instead.
 #[must_use]
-pub fn offset_origin<S: SpawnScalar>(tri: &Triangle<S>, u: S, v: S, toward: S::Vec3) -> [S; 3] {
+pub fn offset_origin<S: Scalar>(tri: &Triangle<S>, u: S, v: S, toward: S::Vec3) -> [S; 3] {
     let vf = tri.v.map(|p| p.map(S::to_f64));
     let (uf, vv) = (u.to_f64(), v.to_f64());
     let e1 = sub(&vf[1], &vf[0]);
@@ -232,7 +126,7 @@ pub fn offset_origin<S: SpawnScalar>(tri: &Triangle<S>, u: S, v: S, toward: S::V
     let p: [f64; 3] = core::array::from_fn(|k| vf[0][k] + uf * e1[k] + vv * e2[k]);
     let d = S::vec_to_array(toward).map(S::to_f64);
     let m = vf.iter().fold(max_abs(0.0, &p), max_abs);
-    let delta = S::offset(m);
+    let delta = S::spawn_offset(m);
 
     let Some(n) = unit(normal_f64(&vf)) else {
         // Degenerate triangle (never hit by the kernel): step along the new direction.
@@ -275,7 +169,7 @@ pub fn offset_origin<S: SpawnScalar>(tri: &Triangle<S>, u: S, v: S, toward: S::V
 ///
 /// # Errors
 /// As [`Ray::new`] (zero or non-finite `dir`, or an origin pushed out of range).
-pub fn spawn_ray<S: SpawnScalar>(
+pub fn spawn_ray<S: Scalar>(
     ray: &Ray<S>,
     hit: &Hit<S>,
     tri: &Triangle<S>,
@@ -293,7 +187,7 @@ pub fn spawn_ray<S: SpawnScalar>(
 ///
 /// # Errors
 /// As [`Ray::new`]; [`RayError::ZeroDirection`] if the origin and the target coincide.
-pub fn spawn_shadow_ray<S: SpawnScalar>(
+pub fn spawn_shadow_ray<S: Scalar>(
     ray: &Ray<S>,
     hit: &Hit<S>,
     tri: &Triangle<S>,
@@ -325,6 +219,6 @@ pub fn spawn_shadow_ray<S: SpawnScalar>(
 /// The shadow-ray `t_max` rule for a target at distance `len`: `len·(1 − SHADOW_SHORTEN)`
 /// rounded down, minus one unit (ulp or raw).
 #[must_use]
-pub fn shadow_t_max<S: SpawnScalar>(len: f64) -> S {
+pub fn shadow_t_max<S: Scalar>(len: f64) -> S {
     S::t_down(len * (1.0 - SHADOW_SHORTEN), 1)
 }

@@ -22,9 +22,8 @@ use super::scene::Shape;
 use super::vector;
 use super::{RenderFeatures, Renderer};
 use crate::accel::AccelFamily;
-use crate::geom::spawn::SpawnScalar;
 use crate::geom::Triangle;
-use crate::scalar::sqrtf;
+use crate::scalar::{sqrtf, Scalar};
 use core::f32::consts::PI;
 use glam::Vec3;
 
@@ -41,7 +40,7 @@ pub(super) struct EmitterSample {
 
 /// The object holding emissive primitive `k` (`k < Geometry::emitter_count`) and `k`'s index
 /// within it.
-fn emitter<'g, 'a, S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+fn emitter<'g, 'a, S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &'g Renderer<'a, S, F, K>,
     k: u32,
 ) -> Option<(&'g ObjectGeom<'a, S, F>, u32)> {
@@ -55,7 +54,7 @@ fn emitter<'g, 'a, S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
 }
 
 /// Triangle `tri`'s corners in world space at the displacement `d`, in `f32`.
-fn corners<S: SpawnScalar>(tri: &Triangle<S>, d: [f64; 3]) -> [Vec3; 3] {
+fn corners<S: Scalar>(tri: &Triangle<S>, d: [f64; 3]) -> [Vec3; 3] {
     tri.v.map(|p| {
         let q: [f64; 3] = core::array::from_fn(|k| S::to_f64(p[k]) + d[k]);
         Vec3::new(q[0] as f32, q[1] as f32, q[2] as f32)
@@ -67,7 +66,7 @@ fn corners<S: SpawnScalar>(tri: &Triangle<S>, d: [f64; 3]) -> [Vec3; 3] {
 /// `None` when the sample contributes nothing (below the horizon, behind a one-sided
 /// emitter, inside a sphere).
 #[allow(clippy::too_many_arguments)]
-pub(super) fn sample<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(super) fn sample<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     pf: Vec3,
     nf: Vec3,
@@ -167,7 +166,7 @@ pub(super) fn sample<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
 /// towards primitive `local` of object `object`, which a ray along `dir` hit at distance `t`
 /// (0 where it cannot: not an emitter, inside a sphere, a degenerate triangle).
 #[cfg_attr(not(feature = "path-tracing"), allow(dead_code))]
-pub(super) fn density<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(super) fn density<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     object: usize,
     local: u32,

@@ -17,8 +17,8 @@ use super::surface::{Prim, SurfacePoint};
 use super::SceneError;
 use crate::accel::bvh::Bvh;
 use crate::accel::{take, AccelFamily, BuildError, Counters, MemoryNeeded};
-use crate::geom::spawn::{cross, sub, unit, SpawnScalar};
-use crate::geom::{closer, Aabb, Primitive, Ray, Sphere};
+use crate::geom::spawn::{cross, sub, unit};
+use crate::geom::{closer, Aabb, Barycentrics, Primitive, Ray, Sphere};
 use crate::scalar::Scalar;
 
 /// What a closest hit found.
@@ -63,7 +63,7 @@ pub(crate) struct Geometry<'a, S: Scalar, F: AccelFamily<S>> {
     pub(crate) emitter_count: u32,
 }
 
-impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
+impl<'a, S: Scalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     /// Builds every object's accelerator into the caller's memory ([`memory_needed`]).
     pub(crate) fn build<K: RenderFeatures>(
         objects: &'a [Object<'a, S>],
@@ -90,8 +90,9 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
             let (needed, available) = (need.objects, slots.len());
             return Err(err(0, "objects", Problem::TooSmall { needed, available }));
         }
-        if let Some((field, needed, available)) = need.accel.first_shortfall(&memory.available()) {
-            return Err(err(0, field, Problem::TooSmall { needed, available }));
+        if let Some(s) = need.accel.first_shortfall(&memory.available()) {
+            let (needed, available) = (s.needed, s.available);
+            return Err(err(0, s.field, Problem::TooSmall { needed, available }));
         }
         let slots = take(&mut slots, objects.len());
         let mut base = 0u32;
@@ -343,7 +344,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
             Shape::Triangles(t) => {
                 let tri = t.get(local as usize)?;
                 // Barycentrics as the accelerator gives them: from the ray in the object's frame.
-                let (hu, hv) = match o.motion {
+                let Barycentrics { u: hu, v: hv } = match o.motion {
                     None => tri.hit_uv(ray.data()),
                     Some(m) => tri.hit_uv(moved_into_frame::<S>(m, ray, time)?.data()),
                 };
@@ -387,7 +388,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     }
 }
 
-impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
+impl<'a, S: Scalar, F: AccelFamily<S>> Geometry<'a, S, F> {
     /// The unit geometric normal [`Geometry::surface_point`] gives for hit `h`, without the
     /// rest of the surface point (no barycentrics). `None` for lights.
     pub(crate) fn normal_at(&self, ray: &Ray<S>, h: &SceneHit<S>, time: f32) -> Option<[f32; 3]> {
@@ -412,14 +413,14 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Geometry<'a, S, F> {
 }
 
 /// A triangle's unit geometric normal `(v1 − v0) × (v2 − v0)` (degenerate: against the ray).
-fn triangle_normal<S: SpawnScalar>(v: &[[f64; 3]; 3], ray: &Ray<S>) -> [f64; 3] {
+fn triangle_normal<S: Scalar>(v: &[[f64; 3]; 3], ray: &Ray<S>) -> [f64; 3] {
     unit(cross(&sub(&v[1], &v[0]), &sub(&v[2], &v[0])))
         .unwrap_or_else(|| S::ray_dir(ray.data()).map(|x| -x.to_f64()))
 }
 
 /// A sphere's unit outward normal at the ray's hit `t`, the sphere displaced by `d` (the hit
 /// point from the ray in the sphere's frame; at the centre: against the ray).
-fn sphere_normal<S: SpawnScalar>(sp: &Sphere<S>, ray: &Ray<S>, t: S, d: [f64; 3]) -> [f64; 3] {
+fn sphere_normal<S: Scalar>(sp: &Sphere<S>, ray: &Ray<S>, t: S, d: [f64; 3]) -> [f64; 3] {
     let c = sp.center.map(S::to_f64);
     let o3 = S::vec_to_array(ray.origin()).map(S::to_f64);
     let dir = S::ray_dir(ray.data()).map(S::to_f64);

@@ -12,8 +12,8 @@ use super::vector;
 use super::{RenderFeatures, RenderPlan, RenderStats, Renderer};
 use crate::accel::AccelFamily;
 use crate::accel::NoStats;
-use crate::geom::spawn::SpawnScalar;
 use crate::geom::Ray;
+use crate::scalar::Scalar;
 use core::f32::consts::FRAC_1_PI;
 use glam::Vec3;
 
@@ -25,7 +25,7 @@ use glam::Vec3;
 /// tenth. Bare-metal targets keep the optimiser's choice, for flash (see `ray_data` in
 /// `scalar/float.rs`).
 #[cfg_attr(not(target_os = "none"), inline(always))]
-pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(crate) fn sample_radiance<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     x: u32,
     y: u32,
@@ -133,7 +133,7 @@ pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatur
 /// the pixel position, lens and time drawn from `stream` in that order, as far as the plan uses
 /// them. Both integrators start their paths here.
 #[inline(always)]
-pub(crate) fn camera_sample<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(crate) fn camera_sample<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     x: u32,
     y: u32,
@@ -169,7 +169,7 @@ pub(crate) fn camera_sample<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures
 /// bits as [`sample_radiance`] under that plan (the same operations in the same order),
 /// without its sample stream, path state and bounce loop.
 #[cfg_attr(not(target_os = "none"), inline(always))]
-pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(crate) fn camera_ray_radiance<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     x: u32,
     y: u32,
@@ -213,7 +213,7 @@ pub(crate) fn camera_ray_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFe
 
 /// Object `object`'s material (`None` only for an index the renderer's checks rule out).
 #[inline]
-pub(super) fn material_of<'r, S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(super) fn material_of<'r, S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &'r Renderer<'_, S, F, K>,
     object: usize,
 ) -> Option<&'r Material> {
@@ -226,7 +226,7 @@ pub(super) fn material_of<'r, S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatur
 /// the object is one-sided ([`super::Object::one_sided`]): the back is black and ends the path.
 /// The side is the one shading sees: the sign of `dir` against the surface point's normal.
 #[inline]
-pub(super) fn behind_one_sided<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(super) fn behind_one_sided<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     ray: &Ray<S>,
     hit: &SceneHit<S>,
@@ -243,7 +243,7 @@ pub(super) fn behind_one_sided<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatu
 /// Radiance object `object` emits ([`super::Object::emission`]; zero for an index the
 /// renderer's checks rule out).
 #[inline]
-pub(super) fn emission_of<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(super) fn emission_of<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     object: usize,
 ) -> Vec3 {
@@ -256,7 +256,7 @@ pub(super) fn emission_of<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
 /// material's (zero for an index the renderer's checks rule out).
 #[cfg_attr(not(feature = "path-tracing"), allow(dead_code))]
 #[inline]
-pub(super) fn emitted<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(super) fn emitted<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     object: usize,
 ) -> Vec3 {
@@ -281,7 +281,7 @@ pub(super) fn reflect(d: Vec3, n: Vec3) -> Vec3 {
 }
 
 /// Radiance a camera or reflection ray sees on light `i`'s surface.
-pub(super) fn light_seen<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(super) fn light_seen<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     i: usize,
     dir: Vec3,

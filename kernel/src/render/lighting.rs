@@ -11,9 +11,9 @@ use super::surface::{dir_in_mode, Facing, SurfacePoint};
 use super::vector;
 use super::{RenderFeatures, RenderStats, Renderer};
 use crate::accel::{AccelFamily, NoStats};
-use crate::geom::spawn::{shadow_t_max, SpawnScalar};
+use crate::geom::spawn::shadow_t_max;
 use crate::geom::Ray;
-use crate::scalar::sqrtf;
+use crate::scalar::{sqrtf, Scalar};
 use core::f32::consts::{FRAC_1_PI, PI};
 use glam::Vec3;
 
@@ -70,7 +70,7 @@ pub(super) fn phong_density(c: f32, exponent: f32) -> f32 {
 /// branch for what it does not use. Bare-metal targets keep one copy, for flash.
 #[allow(clippy::too_many_arguments)]
 #[cfg_attr(not(target_os = "none"), inline(always))]
-pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(super) fn light_sum<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     sp: &SurfacePoint<'_, S>,
     facing: Facing,
@@ -185,7 +185,7 @@ pub(super) fn light_sum<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
 /// in their shading loop.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-fn emitter_light<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+fn emitter_light<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     sp: &SurfacePoint<'_, S>,
     facing: Facing,
@@ -215,7 +215,7 @@ fn emitter_light<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
 /// `from` towards light `i`, whose surface a ray along `dir` hit (0 where it samples nothing:
 /// point lights, a rectangle's back, the inside of a sphere light).
 #[cfg_attr(not(feature = "path-tracing"), allow(dead_code))]
-pub(super) fn light_pdf<S: SpawnScalar, F: AccelFamily<S>>(
+pub(super) fn light_pdf<S: Scalar, F: AccelFamily<S>>(
     lights: &[Light],
     geometry: &Geometry<'_, S, F>,
     i: usize,
@@ -267,7 +267,7 @@ const EMITTER_SHORTEN: f64 = 1.0 / 1024.0;
 /// hosted targets as [`light_sum`] is (two integrators call it; left alone, the optimiser
 /// keeps it out of line and the direct integrator pays the calls).
 #[cfg_attr(not(target_os = "none"), inline(always))]
-fn visible<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+fn visible<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     sp: &SurfacePoint<'_, S>,
     target: [f32; 3],

@@ -87,7 +87,7 @@ pub(super) fn light_geom<S: Scalar, K: RenderFeatures>(
                 center: c,
                 radius: r,
             };
-            s.check().map_err(|(_, e)| ("radius", point_problem(e)))?;
+            s.check().map_err(|e| ("radius", point_problem(e.error)))?;
             Ok(LightGeom::Sphere(s))
         }
     }

@@ -48,8 +48,8 @@ pub use srgb::encode_srgb8;
 pub use surface::SPHERE_SPAWN_FACTOR;
 
 use crate::accel::{AccelFamily, AnyFamily};
-use crate::geom::spawn::SpawnScalar;
 use crate::geom::Ray;
+use crate::scalar::Scalar;
 use camera::CameraFrame;
 use core::fmt;
 use core::marker::PhantomData;
@@ -123,7 +123,7 @@ impl RenderPlan {
             && unlit
     }
 
-    fn derive<S: SpawnScalar>(scene: &Scene<'_, S>, settings: &Settings) -> Self {
+    fn derive<S: Scalar>(scene: &Scene<'_, S>, settings: &Settings) -> Self {
         let used = |f: fn(&Material) -> bool| {
             scene
                 .objects
@@ -287,12 +287,7 @@ impl RenderStats {
 /// accelerators return the same closest hit, ties to the lowest id). `K` names the parts of
 /// the renderer linked beyond its core ([`RenderFeatures`]; [`AllFeatures`] by default).
 #[derive(Clone, Debug)]
-pub struct Renderer<
-    'a,
-    S: SpawnScalar,
-    F: AccelFamily<S> = AnyFamily,
-    K: RenderFeatures = AllFeatures,
-> {
+pub struct Renderer<'a, S: Scalar, F: AccelFamily<S> = AnyFamily, K: RenderFeatures = AllFeatures> {
     geometry: Geometry<'a, S, F>,
     materials: &'a [Material],
     lights: &'a [Light],
@@ -308,7 +303,7 @@ pub struct Renderer<
     features: PhantomData<K>,
 }
 
-impl<'a, S: SpawnScalar, F: AccelFamily<S>> Renderer<'a, S, F> {
+impl<'a, S: Scalar, F: AccelFamily<S>> Renderer<'a, S, F> {
     /// Checks the scene and settings, builds every object's accelerator with `accel` into
     /// `memory` (at least what [`memory_needed`] gives) and derives the plan. Links every part
     /// of the renderer ([`AllFeatures`]); [`Renderer::with_features`] links fewer.
@@ -327,7 +322,7 @@ impl<'a, S: SpawnScalar, F: AccelFamily<S>> Renderer<'a, S, F> {
     }
 }
 
-impl<'a, S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures> Renderer<'a, S, F, K> {
+impl<'a, S: Scalar, F: AccelFamily<S>, K: RenderFeatures> Renderer<'a, S, F, K> {
     /// As [`Renderer::new`], linking only the parts of the renderer `K` names.
     ///
     /// # Errors
@@ -578,7 +573,7 @@ fn check_settings(s: &Settings) -> Result<(), SceneError> {
 }
 
 /// Refuses what the scene or settings need of the parts `K` leaves out.
-fn check_linked<S: SpawnScalar, K: RenderFeatures>(
+fn check_linked<S: Scalar, K: RenderFeatures>(
     scene: &Scene<'_, S>,
     settings: &Settings,
 ) -> Result<(), SceneError> {
@@ -617,7 +612,7 @@ fn check_linked<S: SpawnScalar, K: RenderFeatures>(
     Ok(())
 }
 
-fn check_materials<S: SpawnScalar>(scene: &Scene<'_, S>) -> Result<(), SceneError> {
+fn check_materials<S: Scalar>(scene: &Scene<'_, S>) -> Result<(), SceneError> {
     for (i, m) in scene.materials.iter().enumerate() {
         let err = |field, p| SceneError::new(Item::Material, i, field, p);
         match *m {

@@ -6,17 +6,17 @@
 //! this covers the rounding of the shifted origin; the slab test's own margin covers the
 //! origin's share).
 
-use crate::geom::spawn::SpawnScalar;
 use crate::geom::{Aabb, Ray};
+use crate::scalar::Scalar;
 
 /// `+ d` in the mode, rounded once.
-pub(super) fn shifted<S: SpawnScalar>(p: [S; 3], d: [f64; 3], sign: f64) -> [S; 3] {
+pub(super) fn shifted<S: Scalar>(p: [S; 3], d: [f64; 3], sign: f64) -> [S; 3] {
     S::point_from_f64(core::array::from_fn(|k| p[k].to_f64() + sign * d[k]))
 }
 
 /// `ray` moved into the frame of an object moving by `motion`, at shutter time `time`: origin
 /// minus the displacement. `None` if the moved origin leaves the mode's range.
-pub(super) fn moved_into_frame<S: SpawnScalar>(
+pub(super) fn moved_into_frame<S: Scalar>(
     motion: [f32; 3],
     ray: &Ray<S>,
     time: f32,
@@ -30,13 +30,13 @@ pub(super) fn moved_into_frame<S: SpawnScalar>(
 }
 
 /// `round(time·motion)` in the mode, as `f64` (exact).
-pub(super) fn displacement<S: SpawnScalar>(m: [f32; 3], time: f32) -> [f64; 3] {
+pub(super) fn displacement<S: Scalar>(m: [f32; 3], time: f32) -> [f64; 3] {
     let d = S::point_from_f64(m.map(|x| f64::from(x) * f64::from(time)));
     d.map(S::to_f64)
 }
 
 /// The box over the whole shutter, padded as the module docs state.
-pub(super) fn swept_box<S: SpawnScalar>(b: &Aabb<S>, m: [f32; 3]) -> Aabb<S> {
+pub(super) fn swept_box<S: Scalar>(b: &Aabb<S>, m: [f32; 3]) -> Aabb<S> {
     let d = displacement::<S>(m, 1.0);
     let pad = m
         .iter()

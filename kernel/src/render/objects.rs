@@ -3,8 +3,8 @@
 
 use super::scene::Shape;
 use crate::accel::{Accel, AccelFamily, AccelMemory, BuildError, Counters, Nearest};
-use crate::geom::{Aabb, Primitive, Ray, Sphere, Triangle};
-use crate::scalar::{PointError, Scalar};
+use crate::geom::{Aabb, Barycentrics, Primitive, Ray, Sphere, Triangle, VertexError};
+use crate::scalar::Scalar;
 
 /// An object's accelerator, over its kind of primitive.
 pub(super) enum ShapeAccel<'a, S: Scalar, F: AccelFamily<S>> {
@@ -96,15 +96,15 @@ impl<S: Scalar, F: AccelFamily<S>> Primitive<S> for ObjectSlot<'_, S, F> {
         self.0
             .map_or(Aabb::new([S::ZERO; 3], [S::ZERO; 3]), |o| o.swept)
     }
-    fn check(&self) -> Result<(), (usize, PointError)> {
+    fn check(&self) -> Result<(), VertexError> {
         Ok(())
     }
     fn hit_t(&self, ray: &S::RayData, t_min: S, t_max: S) -> Option<S> {
         let b = self.bounds();
         S::slab(ray, &b.lo, &b.hi, t_min, t_max)
     }
-    fn hit_uv(&self, _ray: &S::RayData) -> (S, S) {
-        (S::ZERO, S::ZERO)
+    fn hit_uv(&self, _ray: &S::RayData) -> Barycentrics<S> {
+        Barycentrics::ZERO
     }
 }
 

@@ -27,8 +27,8 @@ use super::surface::dir_in_mode;
 use super::vector;
 use super::{RenderFeatures, RenderStats, Renderer};
 use crate::accel::{AccelFamily, NoStats};
-use crate::geom::spawn::SpawnScalar;
 use crate::geom::Ray;
+use crate::scalar::Scalar;
 use core::f32::consts::FRAC_1_PI;
 use glam::Vec3;
 
@@ -52,7 +52,7 @@ enum Previous {
 /// Never inlined: a path costs many rays, so the call is nothing to it, while inlined into the
 /// pixel loop it would change how the optimiser treats the direct integrator's loop there.
 #[inline(never)]
-pub(crate) fn sample_radiance<S: SpawnScalar, F: AccelFamily<S>, K: RenderFeatures>(
+pub(crate) fn sample_radiance<S: Scalar, F: AccelFamily<S>, K: RenderFeatures>(
     r: &Renderer<'_, S, F, K>,
     x: u32,
     y: u32,

@@ -94,11 +94,11 @@ impl<'d> SceneData<'d> {
             return Err(SceneError::new(Item::Object, 0, "triangles", p));
         }
         for (i, (t, slot)) in self.triangles.iter().zip(out.iter_mut()).enumerate() {
-            *slot = Triangle::from_f32(*t).map_err(|(vertex, error)| {
+            *slot = Triangle::from_f32(*t).map_err(|e| {
                 let p = Problem::Build(crate::accel::BuildError::BadPrimitive {
                     prim: i,
-                    vertex,
-                    error,
+                    vertex: e.vertex,
+                    error: e.error,
                 });
                 SceneError::new(Item::Object, self.owner(i, false), "triangles", p)
             })?;

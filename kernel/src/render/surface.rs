@@ -2,7 +2,7 @@
 //! the object's frame when it moves.
 
 use super::motion::shifted;
-use crate::geom::spawn::{self, sub, SpawnScalar, MAX_NUDGES};
+use crate::geom::spawn::{self, sub, MAX_NUDGES};
 use crate::geom::{Sphere, Triangle};
 use crate::scalar::Scalar;
 use glam::Vec3;
@@ -72,7 +72,7 @@ impl<S: Scalar> SurfacePoint<'_, S> {
     }
 }
 
-impl<S: SpawnScalar> SurfacePoint<'_, S> {
+impl<S: Scalar> SurfacePoint<'_, S> {
     /// An origin for a ray leaving the surface towards `toward` (any length), off the surface
     /// on `toward`'s side by the spawn rule of [`crate::spawn`], checked in the object's frame
     /// after the motion shift (so the object's own test sees it on the right side).
@@ -109,7 +109,7 @@ impl<S: SpawnScalar> SurfacePoint<'_, S> {
                 let c = sp.center.map(S::to_f64);
                 let r = sp.radius.to_f64();
                 let m = c.iter().fold(r, |m, x| libm::fmax(m, libm::fabs(*x) + r));
-                let delta = SPHERE_SPAWN_FACTOR * S::offset(m);
+                let delta = SPHERE_SPAWN_FACTOR * S::spawn_offset(m);
                 let s = if outside { 1.0 } else { -1.0 };
                 let local: [f64; 3] = core::array::from_fn(|k| c[k] + (r + s * delta) * n[k]);
                 let mut world = shifted(S::point_from_f64(local), self.shift, 1.0);

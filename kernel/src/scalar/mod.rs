@@ -3,9 +3,9 @@
 //! Every algorithm above this module (builders, traversal, queries) is written once, generic over
 //! [`Scalar`]. What must differ between the modes lives here: the public trait holds what a caller
 //! needs (constants, conversions, checks); its sealed supertrait `Numerics` holds how a ray is
-//! prepared, the conservative slab test and the exact-as-possible primitive tests, which the
-//! kernel reaches through `S: Scalar` and callers never name. Each mode's numerics sit in its
-//! own file (`float.rs`, `fixed.rs`).
+//! prepared, the conservative slab test, the exact-as-possible primitive tests and the rounding
+//! steps of [`crate::spawn`], which the kernel reaches through `S: Scalar` and callers never name.
+//! Each mode's numerics sit in its own file (`float.rs`, `fixed.rs`).
 
 mod error;
 mod fixed;
@@ -156,6 +156,19 @@ pub(crate) mod sealed {
         ) -> Option<Self>;
         /// `center - r` and `center + r` per axis, rounded outward.
         fn sphere_bounds(center: &[Self; 3], radius: Self) -> ([Self; 3], [Self; 3]);
+
+        /// A point rounded to the nearest representable one (saturating at the mode's range).
+        fn point_from_f64(p: [f64; 3]) -> [Self; 3];
+        /// The distance [`crate::spawn`] moves a ray origin off a triangle's plane, for a triangle
+        /// and hit point of largest coordinate magnitude `m`.
+        fn spawn_offset(m: f64) -> f64;
+        /// Sign of `n·(p − v0)` with `n = (v1−v0)×(v2−v0)`: exact in fixed point, `f64` for `f32`.
+        fn side(v: &[[Self; 3]; 3], p: &[Self; 3]) -> i32;
+        /// `x` moved one unit (ulp or raw) up or down; non-finite `f32` values stay unchanged.
+        fn step(x: Self, up: bool) -> Self;
+        /// A distance rounded toward zero to this mode, with `extra` further units taken off
+        /// (never below zero).
+        fn t_down(t: f64, extra: u32) -> Self;
     }
 }
 
@@ -183,6 +196,8 @@ pub trait Scalar:
 
     /// Converts to `f32` (exact for `f32`; rounds to nearest for fixed point).
     fn to_f32(self) -> f32;
+    /// Converts to `f64` (exact in both modes).
+    fn to_f64(self) -> f64;
     /// Converts from `f32`, saturating at the representable range (NaN gives zero).
     fn from_f32_saturating(x: f32) -> Self;
     /// Converts one coordinate from `f32`, failing on NaN, infinity or values outside the mode's

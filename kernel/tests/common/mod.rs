@@ -344,7 +344,7 @@ pub fn query<S: TestScalar, A: Accel<S>>(
 
 /// Renders `scene` whole into linear RGB (row-major) with the default accelerator, memory
 /// sized by [`raykernel::render::memory_needed`].
-pub fn render_linear<S: raykernel::spawn::SpawnScalar>(
+pub fn render_linear<S: raykernel::Scalar>(
     scene: &raykernel::render::Scene<'_, S>,
     settings: raykernel::render::Settings,
 ) -> Result<Vec<[f32; 3]>, raykernel::render::SceneError> {

@@ -61,7 +61,7 @@ pub fn triangle_and_sphere<S: Scalar + Bits>() -> Result<(), Failed> {
     let hit = |o: [f32; 3], d: [f32; 3], t_max: f32| {
         let r = Ray::<S>::from_f32(o, d, 0.0, t_max).ok()?;
         tri.intersect(&r)
-            .map(|(t, u, v)| [t.bits(), u.bits(), v.bits()])
+            .map(|h| [h.t.bits(), h.u.bits(), h.v.bits()])
     };
     let want = |t: f32, u: f32, v: f32| Some([f(t).bits(), f(u).bits(), f(v).bits()]);
     let (z, inf) = ([0.0, 0.0, 1.0], f32::INFINITY);

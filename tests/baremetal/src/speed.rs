@@ -18,8 +18,7 @@ use crate::counter::{self, Rate};
 use crate::{exit, golden};
 use raykernel::bvh::{nodes_needed, BuildOptions};
 use raykernel::render::scenes::{self, SceneData};
-use raykernel::spawn::SpawnScalar;
-use raykernel::{Accel, Bvh, Linear, Node, Ray};
+use raykernel::{Accel, Bvh, Linear, Node, Ray, Scalar};
 use semihosting::println;
 
 /// Calibration loop length: `2 * SPIN` instructions.
@@ -27,7 +26,7 @@ const SPIN: u32 = 1_000_000;
 
 /// Calibrates the counter, counts the ray and pixel workloads in mode `S` and exits (0 if
 /// every answer was golden).
-pub fn run<S: Bits + SpawnScalar>() -> ! {
+pub fn run<S: Bits + Scalar>() -> ! {
     counter::start();
     let rate = counter::calibrate(SPIN);
     let tenths = rate.per_tick_tenths();
@@ -103,7 +102,7 @@ fn rays<S: Bits>(rate: Rate) -> bool {
 /// Counts the render of built-in scene `scene` in mode `S`, hashed row by row; true if the
 /// hash equals golden case `render_<scene>_<mode>`.
 #[inline(never)]
-fn pixels<S: Bits + SpawnScalar>(scene_name: &str, scene: &SceneData<'_>, rate: Rate) -> bool {
+fn pixels<S: Bits + Scalar>(scene_name: &str, scene: &SceneData<'_>, rate: Rate) -> bool {
     let mut buf = [0u8; 32];
     let case = golden_name(&mut buf, scene_name, S::NAME);
     let name = S::NAME;

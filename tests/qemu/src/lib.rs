@@ -18,8 +18,7 @@ use cases::Fail;
 use raykernel::bvh::{Sah, StaticBuild};
 use raykernel::render::scenes::SceneData;
 use raykernel::render::AllFeatures;
-use raykernel::spawn::SpawnScalar;
-use raykernel::BvhFamily;
+use raykernel::{BvhFamily, Scalar};
 
 /// A short description of a failed case.
 pub fn fail_name(f: Fail) -> &'static str {
@@ -45,12 +44,12 @@ pub type RenderFamily = BvhFamily<StaticBuild<Sah, false>>;
 
 /// Renders built-in scene `data` in mode `S` with [`RenderFamily`] and every part of the
 /// renderer, and hashes it ([`cases::render_hash`]).
-pub fn render_hash<S: cases::Bits + SpawnScalar>(data: &SceneData<'_>) -> Result<u64, Fail> {
+pub fn render_hash<S: cases::Bits + Scalar>(data: &SceneData<'_>) -> Result<u64, Fail> {
     cases::render_hash_with::<S, RenderFamily, AllFeatures>(data, StaticBuild::default())
 }
 
 /// As [`check_golden`] for the render case `name`: built-in scene `scene` in mode `S`.
-pub fn check_render_golden<S: cases::Bits + SpawnScalar>(name: &str, scene: &SceneData<'_>) {
+pub fn check_render_golden<S: cases::Bits + Scalar>(name: &str, scene: &SceneData<'_>) {
     check_golden_with(name, |_| render_hash::<S>(scene))
 }
 

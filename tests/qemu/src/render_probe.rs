@@ -13,15 +13,14 @@ use raykernel::render::{
     encode_srgb8, memory_needed, Object, ObjectSlot, RenderMemory, RenderStats, Renderer, Settings,
     Shape, Tile,
 };
-use raykernel::spawn::SpawnScalar;
-use raykernel::{AccelKind, AccelMemory, AnyFamily, KdNode, Node, Node4, Sphere, Triangle};
+use raykernel::{AccelKind, AccelMemory, AnyFamily, KdNode, Node, Node4, Scalar, Sphere, Triangle};
 
 const TRIS: usize = 24;
 const SPHERES: usize = 4;
 const OBJECTS: usize = 8;
 const WORDS: usize = 512;
 
-fn exercise<S: SpawnScalar>(data: &SceneData<'_>, settings: Settings, accel: AccelKind) {
+fn exercise<S: Scalar>(data: &SceneData<'_>, settings: Settings, accel: AccelKind) {
     let mut tris = [Triangle::<S> {
         v: [[S::ZERO; 3]; 3],
     }; TRIS];
@@ -78,7 +77,7 @@ fn exercise<S: SpawnScalar>(data: &SceneData<'_>, settings: Settings, accel: Acc
 }
 
 /// Every accelerator on the built-in Cornell box in mode `S`; never returns.
-pub fn run<S: SpawnScalar>() -> ! {
+pub fn run<S: Scalar>() -> ! {
     let data = black_box(&scenes::CORNELL);
     let settings = black_box(data.settings);
     for accel in black_box(AccelKind::ALL) {

@@ -80,7 +80,7 @@ fn slab_cases<S: Scalar>() {
 }
 
 fn triangle_cases<S: Scalar + Bits>() {
-    use raykernel::{Ray, Sphere};
+    use raykernel::{Ray, Sphere, TriangleHit};
     let tri = Triangle::<S>::from_f32([[-1.0, -1.0, 5.0], [1.0, -1.0, 5.0], [0.0, 1.0, 5.0]]);
     defmt::assert!(tri.is_ok());
     let Ok(tri) = tri else { return };
@@ -89,7 +89,7 @@ fn triangle_cases<S: Scalar + Bits>() {
         let r = Ray::<S>::from_f32(o, d, 0.0, t_max).ok()?;
         tri.intersect(&r)
     };
-    let bits = |h: Option<(S, S, S)>| h.map(|(t, u, v)| (t.bits(), u.bits(), v.bits()));
+    let bits = |h: Option<TriangleHit<S>>| h.map(|h| (h.t.bits(), h.u.bits(), h.v.bits()));
     // Interior point (0, 0) = 0.25·b + 0.5·c + 0.25·a: exact in both modes.
     let want = Some((f(5.0).bits(), f(0.25).bits(), f(0.5).bits()));
     let inf = f32::INFINITY;

@@ -27,7 +27,7 @@ pub use write::{bake_bvh, bake_bvh4, baked_len};
 use crate::accel::bvh::{Bvh, Node, RefitError, TreeShape};
 use crate::accel::bvh4::{Bvh4, Node4};
 use crate::accel::{Accel, AnyAccel, Counters, Nearest};
-use crate::geom::{Ray, Triangle};
+use crate::geom::{Barycentrics, Ray, Triangle};
 
 /// A loaded baked tree of either kind.
 #[derive(Clone, Copy, Debug)]
@@ -162,7 +162,7 @@ impl<S: BakedScalar> Accel<S> for Baked<'_, S> {
             Self::Bvh4(t) => t.occluded_counted(ray, stats),
         }
     }
-    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
+    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> Barycentrics<S> {
         match self {
             Self::Bvh(t) => t.barycentrics(ray, found),
             Self::Bvh4(t) => t.barycentrics(ray, found),

@@ -66,12 +66,11 @@ impl core::error::Error for RefitError {}
 /// Checks every primitive as the builder does.
 pub(crate) fn check_prims<S: Scalar, P: Primitive<S>>(prims: &[P]) -> Result<(), RefitError> {
     for (index, p) in prims.iter().enumerate() {
-        p.check()
-            .map_err(|(vertex, error)| RefitError::BadPrimitive {
-                index,
-                vertex,
-                error,
-            })?;
+        p.check().map_err(|e| RefitError::BadPrimitive {
+            index,
+            vertex: e.vertex,
+            error: e.error,
+        })?;
     }
     Ok(())
 }

@@ -2,7 +2,7 @@
 
 use super::{Bvh, Node, MAX_DEPTH};
 use crate::accel::{Accel, Counters, Nearest};
-use crate::geom::{closer, Primitive, Ray};
+use crate::geom::{closer, Barycentrics, Primitive, Ray};
 use crate::scalar::Scalar;
 
 impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
@@ -135,7 +135,7 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for Bvh<'_, S, P> {
         Nearest::found(t, prim, slot)
     }
 
-    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
+    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> Barycentrics<S> {
         found.barycentrics_in(self.prims, ray)
     }
 

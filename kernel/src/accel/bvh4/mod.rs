@@ -23,7 +23,7 @@ mod refit;
 mod traverse;
 mod validate;
 
-pub use node::Node4;
+pub use node::{ChildSlot, Node4};
 
 use crate::accel::bvh::Bvh;
 use crate::accel::BuildError;

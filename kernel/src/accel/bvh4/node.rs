@@ -5,6 +5,15 @@ use crate::scalar::Scalar;
 /// `count` of an unused child slot.
 pub(crate) const EMPTY_SLOT: u32 = u32::MAX;
 
+/// One of a [`Node4`]'s four child slots, as [`Node4::slot`] reads it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ChildSlot {
+    /// Node index (inner child) or first primitive-id slot (leaf).
+    pub child: u32,
+    /// 0 for an inner child, the primitive count for a leaf, `u32::MAX` unused.
+    pub count: u32,
+}
+
 /// One 4-wide BVH node: the boxes of up to four children in structure-of-arrays form, so one
 /// vector instruction tests an axis of all four. 128 bytes in both modes, aligned to 128: two
 /// cache lines that x86's adjacent-line prefetcher fetches together.
@@ -91,10 +100,12 @@ impl<S: Scalar> Node4<S> {
         let g = |x: Option<&S>| x.copied().unwrap_or(S::ZERO);
         Some(Aabb::new(lo.map(g), hi.map(g)))
     }
-    /// Slot `i`: `(child, count)`; count 0 for an inner child (`child` is a node index), the
-    /// primitive count for a leaf (`child` is the first primitive-id slot), `u32::MAX` unused.
+    /// Slot `i`, if `i < 4`.
     #[must_use]
-    pub fn slot(&self, i: usize) -> Option<(u32, u32)> {
-        Some((*self.child.get(i)?, *self.count.get(i)?))
+    pub fn slot(&self, i: usize) -> Option<ChildSlot> {
+        Some(ChildSlot {
+            child: *self.child.get(i)?,
+            count: *self.count.get(i)?,
+        })
     }
 }

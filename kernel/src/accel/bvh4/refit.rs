@@ -1,7 +1,7 @@
 //! Refit of the 4-wide tree: every slot box recomputed bottom-up after the primitives moved
 //! (see the binary tree's refit for the rule).
 
-use super::{Bvh4, Node4};
+use super::{Bvh4, ChildSlot, Node4};
 use crate::accel::bvh::{leaf_bounds, refit_nodes};
 use crate::accel::bvh::{RefitError, TreeShape};
 use crate::geom::{Aabb, Primitive};
@@ -38,7 +38,7 @@ impl<'a, S: Scalar, P: Primitive<S>> Bvh4<'a, S, P> {
             let node = nodes.get(i).copied().ok_or(mismatch(i))?;
             let mut out = node;
             for slot in 0..node.child_count() {
-                let Some((child, k)) = node.slot(slot) else {
+                let Some(ChildSlot { child, count: k }) = node.slot(slot) else {
                     continue;
                 };
                 let b = if k == 0 {

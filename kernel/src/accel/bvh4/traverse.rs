@@ -4,7 +4,7 @@
 use super::Bvh4;
 use crate::accel::bvh::{test_leaf, LeafPrims, MAX_DEPTH};
 use crate::accel::{Accel, Counters, Nearest};
-use crate::geom::{Primitive, Ray};
+use crate::geom::{Barycentrics, Primitive, Ray};
 use crate::scalar::Scalar;
 
 /// Traversal stack capacity.
@@ -177,7 +177,7 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for Bvh4<'_, S, P> {
         Nearest::found(t, prim, slot)
     }
 
-    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
+    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> Barycentrics<S> {
         found.barycentrics_in(self.prims, ray)
     }
 

@@ -1,6 +1,6 @@
 //! Structural checker for a collapsed tree, called by tests after every collapse.
 
-use super::node::EMPTY_SLOT;
+use super::node::{ChildSlot, EMPTY_SLOT};
 use super::Bvh4;
 use crate::accel::bvh::{
     check_permutation, leaf_bounds, InvalidTree, TreeStats, MAX_DEPTH, MAX_LEAF_SIZE,
@@ -75,7 +75,9 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
             }
             // Push in reverse so slot 0 is visited first.
             for slot in (0..used).rev() {
-                let (Some(b), Some((c, k))) = (node.bounds(slot), node.slot(slot)) else {
+                let (Some(b), Some(ChildSlot { child: c, count: k })) =
+                    (node.bounds(slot), node.slot(slot))
+                else {
                     return Err(InvalidTree::BadChild { node: index });
                 };
                 if k == 0 {

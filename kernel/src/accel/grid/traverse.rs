@@ -2,7 +2,7 @@
 
 use super::{Grid, Layout, MAILBOX};
 use crate::accel::{Accel, Counters, Nearest};
-use crate::geom::{closer, Primitive, Ray};
+use crate::geom::{closer, Barycentrics, Primitive, Ray};
 use crate::scalar::Scalar;
 
 /// One axis of the walk. Cells are numbered `m = 0..n` in the order the ray meets them
@@ -266,7 +266,7 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for Grid<'_, S, P> {
         Nearest::found(t, prim, prim as usize)
     }
 
-    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
+    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> Barycentrics<S> {
         found.barycentrics_in(self.prims, ray)
     }
 

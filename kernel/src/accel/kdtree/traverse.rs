@@ -3,7 +3,7 @@
 use super::{KdTree, MAX_DEPTH};
 use crate::accel::grid::MAILBOX;
 use crate::accel::{Accel, Counters, Nearest};
-use crate::geom::{closer, Primitive, Ray};
+use crate::geom::{closer, Barycentrics, Primitive, Ray};
 use crate::scalar::Scalar;
 
 /// A node still to visit: its index, box and slab entry distance.
@@ -159,7 +159,7 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for KdTree<'_, S, P> {
         Nearest::found(t, prim, prim as usize)
     }
 
-    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> (S, S) {
+    fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> Barycentrics<S> {
         found.barycentrics_in(self.prims, ray)
     }
 

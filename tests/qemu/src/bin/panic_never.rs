@@ -11,7 +11,7 @@
 use core::hint::black_box;
 use cortex_m_rt::entry;
 use raykernel::bvh::{nodes_needed, BuildOptions};
-use raykernel::spawn::{spawn_ray, spawn_shadow_ray, SpawnScalar};
+use raykernel::spawn::{spawn_ray, spawn_shadow_ray};
 use raykernel::{
     Aabb, Accel, Bvh, Linear, Node, Primitive, Ray, Scalar, Sphere, TraversalStats, Triangle,
     Vec3x, I16F16,
@@ -42,7 +42,7 @@ fn queries<S: Scalar, P: Primitive<S>>(bvh: &Bvh<'_, S, P>, prims: &[P], ray: &R
 }
 
 /// Secondary rays from a hit: reflection-style and shadow rays.
-fn spawns<S: SpawnScalar>(tri: &Triangle<S>, ray: &Ray<S>) {
+fn spawns<S: Scalar>(tri: &Triangle<S>, ray: &Ray<S>) {
     if let Some(hit) = tri
         .intersect(ray)
         .map(|(t, u, v)| raykernel::Hit { t, prim: 0, u, v })
