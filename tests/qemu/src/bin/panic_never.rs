@@ -43,15 +43,12 @@ fn queries<S: Scalar, P: Primitive<S>>(bvh: &Bvh<'_, S, P>, prims: &[P], ray: &R
 
 /// Secondary rays from a hit: reflection-style and shadow rays.
 fn spawns<S: Scalar>(tri: &Triangle<S>, ray: &Ray<S>) {
-    if let Some(hit) = tri
-        .intersect(ray)
-        .map(|h| raykernel::Hit {
-            t: h.t,
-            prim: 0,
-            u: h.u,
-            v: h.v,
-        })
-    {
+    if let Some(hit) = tri.intersect(ray).map(|h| raykernel::Hit {
+        t: h.t,
+        prim: 0,
+        u: h.u,
+        v: h.v,
+    }) {
         black_box(spawn_ray(ray, &hit, tri, ray.dir()).ok());
         black_box(spawn_shadow_ray(ray, &hit, tri, black_box([S::ZERO; 3])).ok());
     }
