@@ -5,8 +5,8 @@
 //! (`OffsetRayOrigin`, *Physically Based Rendering* 4th ed. §6.8.6): move the origin off the
 //! triangle's plane, along its geometric normal, to the side the new direction points to, by
 //! more than the error of the hit point and of the triangle test. It is written once for both
-//! number modes, generic over [`Scalar`], whose sealed per-mode numerics hold the rounding, the
-//! side test and the unit steps below; it uses no allocation.
+//! number modes, generic over [`Scalar`]; what differs per mode (rounding, the side test, unit
+//! steps) is the sealed `Spawn` supertrait, implemented below. It uses no allocation.
 //!
 //! # The rule and its bound
 //!
@@ -42,7 +42,8 @@
 //! these functions on arbitrary scenes.
 
 use super::{Hit, Ray, Triangle};
-use crate::scalar::{RayError, Scalar};
+use crate::scalar::sealed::Spawn;
+use crate::scalar::{RayError, Scalar, I16F16};
 
 /// Relative offset of the `f32` rule: the origin moves `2^-16·M` off the plane.
 pub const F32_SPAWN_OFFSET: f64 = 1.0 / 65536.0;
@@ -52,6 +53,88 @@ pub const FIXED_SPAWN_OFFSET_RAW: i32 = 2;
 pub const SHADOW_SHORTEN: f64 = 1.0 / 1_048_576.0;
 /// Most unit steps the side check may take.
 pub const MAX_NUDGES: u32 = 64;
+
+impl Spawn for f32 {
+    fn point_from_f64(p: [f64; 3]) -> [f32; 3] {
+        p.map(|x| x as f32)
+    }
+    fn spawn_offset(m: f64) -> f64 {
+        m * F32_SPAWN_OFFSET + f64::from(f32::MIN_POSITIVE)
+    }
+    fn side(v: &[[f32; 3]; 3], p: &[f32; 3]) -> i32 {
+        let f = |a: &[f32; 3]| a.map(f64::from);
+        let n = normal_f64(&[f(&v[0]), f(&v[1]), f(&v[2])]);
+        let d = sub(&f(p), &f(&v[0]));
+        sign(dot(&n, &d))
+    }
+    fn step(x: f32, up: bool) -> f32 {
+        if !x.is_finite() {
+            return x;
+        }
+        if x == 0.0 {
+            let tiny = f32::from_bits(1);
+            return if up { tiny } else { -tiny };
+        }
+        let bits = x.to_bits();
+        f32::from_bits(if (x > 0.0) == up { bits + 1 } else { bits - 1 })
+    }
+    fn t_down(t: f64, extra: u32) -> f32 {
+        let mut r = t as f32;
+        if f64::from(r) > t {
+            r = Self::step(r, false);
+        }
+        for _ in 0..extra {
+            r = Self::step(r, false);
+        }
+        if r > 0.0 {
+            r
+        } else {
+            0.0
+        }
+    }
+}
+
+impl Spawn for I16F16 {
+    fn point_from_f64(p: [f64; 3]) -> [I16F16; 3] {
+        p.map(|x| {
+            let r = libm::round(x * 65536.0);
+            // `as` saturates (and maps NaN to 0).
+            I16F16::from_raw(r as i32)
+        })
+    }
+    fn spawn_offset(_m: f64) -> f64 {
+        f64::from(FIXED_SPAWN_OFFSET_RAW) / 65536.0
+    }
+    fn side(v: &[[I16F16; 3]; 3], p: &[I16F16; 3]) -> i32 {
+        let r = |a: &[I16F16; 3]| a.map(|x| i128::from(x.raw()));
+        let (a, b, c, q) = (r(&v[0]), r(&v[1]), r(&v[2]), r(p));
+        let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        // |e| < 2^32, |n| < 2^65, |q − a| < 2^32: the dot product stays below 2^99.
+        let n = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
+        ];
+        let s = n[0] * (q[0] - a[0]) + n[1] * (q[1] - a[1]) + n[2] * (q[2] - a[2]);
+        match s {
+            0 => 0,
+            s if s > 0 => 1,
+            _ => -1,
+        }
+    }
+    fn step(x: I16F16, up: bool) -> I16F16 {
+        I16F16::from_raw(if up {
+            x.raw().saturating_add(1)
+        } else {
+            x.raw().saturating_sub(1)
+        })
+    }
+    fn t_down(t: f64, extra: u32) -> I16F16 {
+        let raw = libm::floor(t * 65536.0) - f64::from(extra);
+        I16F16::from_raw(if raw > 0.0 { raw as i32 } else { 0 })
+    }
+}
 
 pub(crate) fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
@@ -82,11 +165,6 @@ pub(crate) fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
 /// `(v1 − v0) × (v2 − v0)`.
 fn normal_f64(v: &[[f64; 3]; 3]) -> [f64; 3] {
     cross(&sub(&v[1], &v[0]), &sub(&v[2], &v[0]))
-}
-
-/// Sign of `n·(p − v0)` with `n = (v1−v0)×(v2−v0)`, in `f64`.
-pub(crate) fn side_f64(v: &[[f64; 3]; 3], p: &[f64; 3]) -> i32 {
-    sign(dot(&normal_f64(v), &sub(p, &v[0])))
 }
 
 /// `v / |v|`, scaled first so tiny and huge vectors normalise; `None` for zero or non-finite.

@@ -14,7 +14,6 @@
 use super::sealed::Numerics;
 use super::Scalar;
 use super::{PointError, RayError};
-use crate::geom::spawn::FIXED_SPAWN_OFFSET_RAW;
 use core::ops::{Add, Div, Mul, Neg, Sub};
 
 /// A signed fixed-point number with 16 integer and 16 fraction bits (`value = raw / 65536`).
@@ -478,45 +477,6 @@ impl Numerics for I16F16 {
 
     fn sphere_bounds(center: &[Self; 3], radius: Self) -> ([Self; 3], [Self; 3]) {
         (center.map(|c| c - radius), center.map(|c| c + radius))
-    }
-    fn point_from_f64(p: [f64; 3]) -> [I16F16; 3] {
-        p.map(|x| {
-            let r = libm::round(x * 65536.0);
-            // `as` saturates (and maps NaN to 0).
-            I16F16::from_raw(r as i32)
-        })
-    }
-    fn spawn_offset(_m: f64) -> f64 {
-        f64::from(FIXED_SPAWN_OFFSET_RAW) / 65536.0
-    }
-    fn side(v: &[[I16F16; 3]; 3], p: &[I16F16; 3]) -> i32 {
-        let r = |a: &[I16F16; 3]| a.map(|x| i128::from(x.raw()));
-        let (a, b, c, q) = (r(&v[0]), r(&v[1]), r(&v[2]), r(p));
-        let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        // |e| < 2^32, |n| < 2^65, |q − a| < 2^32: the dot product stays below 2^99.
-        let n = [
-            e1[1] * e2[2] - e1[2] * e2[1],
-            e1[2] * e2[0] - e1[0] * e2[2],
-            e1[0] * e2[1] - e1[1] * e2[0],
-        ];
-        let s = n[0] * (q[0] - a[0]) + n[1] * (q[1] - a[1]) + n[2] * (q[2] - a[2]);
-        match s {
-            0 => 0,
-            s if s > 0 => 1,
-            _ => -1,
-        }
-    }
-    fn step(x: I16F16, up: bool) -> I16F16 {
-        I16F16::from_raw(if up {
-            x.raw().saturating_add(1)
-        } else {
-            x.raw().saturating_sub(1)
-        })
-    }
-    fn t_down(t: f64, extra: u32) -> I16F16 {
-        let raw = libm::floor(t * 65536.0) - f64::from(extra);
-        I16F16::from_raw(if raw > 0.0 { raw as i32 } else { 0 })
     }
 }
 

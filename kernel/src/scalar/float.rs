@@ -20,7 +20,6 @@ use super::lanes::F4;
 use super::sealed::Numerics;
 use super::Scalar;
 use crate::error::{PointError, RayError};
-use crate::geom::spawn::{side_f64, F32_SPAWN_OFFSET};
 use eft::{exact_cross_sum, recip_binade, scale_to_2_60, Df};
 
 /// Largest coordinate magnitude accepted in `f32` mode (2^40, about 1.1e12). Beyond it the
@@ -733,41 +732,6 @@ impl Numerics for f32 {
         }
         (lo, hi)
     }
-    fn point_from_f64(p: [f64; 3]) -> [f32; 3] {
-        p.map(|x| x as f32)
-    }
-    fn spawn_offset(m: f64) -> f64 {
-        m * F32_SPAWN_OFFSET + f64::from(f32::MIN_POSITIVE)
-    }
-    fn side(v: &[[f32; 3]; 3], p: &[f32; 3]) -> i32 {
-        let f = |a: &[f32; 3]| a.map(f64::from);
-        side_f64(&[f(&v[0]), f(&v[1]), f(&v[2])], &f(p))
-    }
-    fn step(x: f32, up: bool) -> f32 {
-        if !x.is_finite() {
-            return x;
-        }
-        if x == 0.0 {
-            let tiny = f32::from_bits(1);
-            return if up { tiny } else { -tiny };
-        }
-        let bits = x.to_bits();
-        f32::from_bits(if (x > 0.0) == up { bits + 1 } else { bits - 1 })
-    }
-    fn t_down(t: f64, extra: u32) -> f32 {
-        let mut r = t as f32;
-        if f64::from(r) > t {
-            r = Self::step(r, false);
-        }
-        for _ in 0..extra {
-            r = Self::step(r, false);
-        }
-        if r > 0.0 {
-            r
-        } else {
-            0.0
-        }
-    }
 }
 
 #[cfg(test)]
@@ -792,7 +756,7 @@ mod tests {
 
     /// The next representable value above (`up`) or below `x`.
     fn step(x: f32, up: bool) -> f32 {
-        <f32 as Numerics>::step(x, up)
+        <f32 as crate::scalar::sealed::Spawn>::step(x, up)
     }
 
     /// `x` moved by `delta` in the given direction, and by at least one ulp: what

@@ -3,9 +3,10 @@
 //! Every algorithm above this module (builders, traversal, queries) is written once, generic over
 //! [`Scalar`]. What must differ between the modes lives here: the public trait holds what a caller
 //! needs (constants, conversions, checks); its sealed supertrait `Numerics` holds how a ray is
-//! prepared, the conservative slab test, the exact-as-possible primitive tests and the rounding
-//! steps of [`crate::spawn`], which the kernel reaches through `S: Scalar` and callers never name.
-//! Each mode's numerics sit in its own file (`float.rs`, `fixed.rs`).
+//! prepared, the conservative slab test and the exact-as-possible primitive tests, which the
+//! kernel reaches through `S: Scalar` and callers never name. Each mode's numerics sit in its own
+//! file (`float.rs`, `fixed.rs`). A second sealed supertrait, `Spawn`, holds the per-mode steps
+//! of [`crate::spawn`]'s rule and is implemented there, next to the rule and its constants.
 
 mod error;
 mod fixed;
@@ -156,7 +157,14 @@ pub(crate) mod sealed {
         ) -> Option<Self>;
         /// `center - r` and `center + r` per axis, rounded outward.
         fn sphere_bounds(center: &[Self; 3], radius: Self) -> ([Self; 3], [Self; 3]);
+    }
 
+    /// The per-mode steps of the spawn rule ([`crate::spawn`]): rounding to the mode, the exact
+    /// side test and unit steps. Implemented next to the rule, in `geom/spawn.rs`; a supertrait
+    /// of [`Scalar`] as [`Numerics`] is.
+    ///
+    /// [`Scalar`]: super::Scalar
+    pub trait Spawn: Sized {
         /// A point rounded to the nearest representable one (saturating at the mode's range).
         fn point_from_f64(p: [f64; 3]) -> [Self; 3];
         /// The distance [`crate::spawn`] moves a ray origin off a triangle's plane, for a triangle
@@ -182,7 +190,16 @@ pub type RayData<S> = <S as sealed::Numerics>::RayData;
 /// platform. Only correctly rounded IEEE operations and `libm` are used in `f32` mode, min/max are
 /// explicit comparisons, and no NaN is ever returned.
 pub trait Scalar:
-    sealed::Numerics + Copy + PartialEq + PartialOrd + Debug + Default + Send + Sync + 'static
+    sealed::Numerics
+    + sealed::Spawn
+    + Copy
+    + PartialEq
+    + PartialOrd
+    + Debug
+    + Default
+    + Send
+    + Sync
+    + 'static
 {
     /// The vector type of the public API: `glam::Vec3` for `f32`, [`crate::Vec3x`] for fixed point.
     type Vec3: Copy + Debug;
