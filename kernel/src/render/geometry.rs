@@ -91,8 +91,11 @@ impl<'a, S: Scalar, F: AccelFamily<S>> Geometry<'a, S, F> {
             return Err(err(0, "objects", Problem::TooSmall { needed, available }));
         }
         if let Some(s) = need.accel.first_shortfall(&memory.available()) {
-            let (needed, available) = (s.needed, s.available);
-            return Err(err(0, s.field, Problem::TooSmall { needed, available }));
+            let problem = Problem::TooSmall {
+                needed: s.needed,
+                available: s.available,
+            };
+            return Err(err(0, s.field, problem));
         }
         let slots = take(&mut slots, objects.len());
         let mut base = 0u32;

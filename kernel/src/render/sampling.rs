@@ -234,6 +234,8 @@ impl SampleStream {
 #[must_use]
 pub fn ceil_sqrt(n: u32) -> u32 {
     // `⌊√n⌋` digit by digit (two bits of `n` per step), then one more unless `n` is a square.
+    // In integers rather than through `crate::scalar::sqrt`: on cores without a double FPU the
+    // conversions to and from `f64` cost more flash than this loop.
     let (mut rest, mut root) = (n, 0u32);
     let mut bit = 1u32 << 30;
     while bit > n {

@@ -72,15 +72,7 @@ pub(crate) fn sqrt(x: f64) -> f64 {
 #[cfg_attr(not(target_os = "none"), allow(dead_code))]
 #[inline(always)]
 fn integer_sqrt_f64(x: f64) -> f64 {
-    // Decided on the bits: comparisons of `f64` are calls on a core without a double FPU.
-    let bits = x.to_bits();
-    if bits << 1 == 0 || bits >> 52 == 0x7ff {
-        return x; // ±0, +inf, +NaN
-    }
-    if bits >> 63 != 0 {
-        return f64::NAN; // below zero, -inf, -NaN
-    }
-    f64::from_bits(root_bits(bits, 52, 1023))
+    f64::from_bits(root_bits(x.to_bits(), 64, 52))
 }
 
 /// `√x` (`f32`) by integer arithmetic only, as [`root_bits`].
@@ -92,20 +84,14 @@ fn integer_sqrt_f64(x: f64) -> f64 {
     allow(dead_code)
 )]
 fn integer_sqrt(x: f32) -> f32 {
-    let bits = x.to_bits();
-    if bits << 1 == 0 || bits >> 23 == 0xff {
-        return x; // ±0, +inf, +NaN
-    }
-    if bits >> 31 != 0 {
-        return f32::NAN; // below zero, -inf, -NaN
-    }
     // The root of a 32-bit float fits in its 32 bits.
-    f32::from_bits(root_bits(u64::from(bits), 23, 127) as u32)
+    f32::from_bits(root_bits(u64::from(x.to_bits()), 32, 23) as u32)
 }
 
 /// The bits of `√x`, correctly rounded (round to nearest; a tie cannot occur), for the bits of
-/// a positive finite float with `p` fraction bits and exponent bias `bias` (`f32`: 23, 127;
-/// `f64`: 52, 1023).
+/// an IEEE float `width` bits wide with `p` fraction bits (`f32`: 32, 23; `f64`: 64, 52):
+/// `±0` and `+inf` as given, NaN for NaN and below zero. Decided on the bits alone, so a core
+/// without a double-precision unit calls no soft-float comparison.
 ///
 /// `x = y·2^e` with `e` even and `y = m·2^-p` in `[1, 4)`. The digit-by-digit root decides
 /// `q = ⌊√y·2^(p+1)⌋` one bit at a time, from `2^(p+1)` down: with the remainder
@@ -114,7 +100,19 @@ fn integer_sqrt(x: f32) -> f32 {
 /// bit more, which alone decides the rounding: `√y·2^(p+1)` is never an odd integer exactly
 /// (its square `m·2^(p+2)` is even), so the discarded remainder cannot make a tie.
 #[cfg_attr(not(target_os = "none"), allow(dead_code))]
-fn root_bits(bits: u64, p: u32, bias: i32) -> u64 {
+fn root_bits(bits: u64, width: u32, p: u32) -> u64 {
+    let exponent_ones = (1u64 << (width - 1 - p)) - 1;
+    let magnitude = bits & ((1u64 << (width - 1)) - 1);
+    if magnitude == 0 {
+        return bits; // ±0
+    }
+    if bits != magnitude {
+        return exponent_ones << p | 1 << (p - 1); // the quiet NaN, for x < 0, -inf and -NaN
+    }
+    if magnitude >> p == exponent_ones {
+        return bits; // +inf, +NaN
+    }
+    let bias = (exponent_ones >> 1) as i32;
     let fraction = bits & ((1 << p) - 1);
     let biased = (bits >> p) as i32;
     let (mut m, mut e) = if biased == 0 {
