@@ -1350,6 +1350,9 @@ fn notes_section(s: &mut String) {
          `bench/scripts/ratios.py data.json` recomputes the headline and round ratios from \
          them.\n\
          - Criterion micro-benchmarks of the hot functions (slab test, triangle test, one \
-         traversal): `cargo bench -p raykernel-bench --bench hot`.\n"
+         traversal): `cargo bench -p raykernel-bench --bench hot`.\n\
+         - The interleaved rounds alone, with ray construction timed apart, for A/B work on the \
+         headline structure (seconds per scene): `cargo run --release -p raykernel-bench \
+         --features embree --example rounds -- --rays RAYS_DIR`.\n"
     );
 }

@@ -1,0 +1,92 @@
+//! The interleaved rounds alone, for quick A/B work on the headline structure: per ray set,
+//! ray construction on its own (ns per ray) and the rounds of `raykernel_bench::rounds` (ours
+//! per ray, Embree HIGH with the `embree` feature, ours on pre-built rays, tinybvh with the
+//! `tinybvh` feature), with the per-round ratio against Embree. Seconds per scene instead of
+//! the full benchmark's quarter hour; the full run stays the one that writes the report.
+//!
+//! ```text
+//! python3 ../shared/bench/make_rays.py --out /tmp/rays bunny sponza kitchen
+//! cargo run --release -p raykernel-bench --features embree --example rounds -- --rays /tmp/rays
+//! ```
+
+use clap::Parser;
+use host::trace::median;
+use raykernel::Ray;
+use raykernel_bench::error::Error;
+use raykernel_bench::ours::RunOptions;
+use raykernel_bench::rounds;
+use raykernel_bench::workload::{load_scenes, RaySet, RaySource};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Interleaved rounds of the headline structure against Embree, without the rest of the
+/// benchmark.
+#[derive(Parser)]
+struct Args {
+    /// Ray files from `make_rays.py --out DIR`.
+    #[arg(long, value_name = "DIR")]
+    rays: PathBuf,
+    /// Directory of the scenes (NAME.obj).
+    #[arg(long, value_name = "DIR", default_value = "../shared/scenes")]
+    scenes: PathBuf,
+    /// Scenes to run (repeatable).
+    #[arg(long = "scene", value_name = "NAME", default_values_t = ["bunny".to_string(), "sponza".to_string(), "kitchen".to_string()])]
+    scene_names: Vec<String>,
+    /// Trace every K-th ray.
+    #[arg(long, value_name = "K", default_value_t = 8)]
+    stride: usize,
+    /// Rounds per ray set.
+    #[arg(long, value_name = "N", default_value_t = 7)]
+    rounds: usize,
+}
+
+/// Median ns per ray of `Ray::from_f32` over every `stride`-th record, in `rounds` timings.
+fn construction_ns(set: &RaySet, stride: usize, rounds: usize) -> f64 {
+    let timings: Vec<f64> = (0..rounds.max(1))
+        .map(|_| {
+            let start = Instant::now();
+            let mut built = 0usize;
+            for r in set.records.iter().step_by(stride) {
+                if let Ok(ray) = Ray::<f32>::from_f32(r.origin, r.dir, r.t_min, r.t_max) {
+                    std::hint::black_box(&ray);
+                    built += 1;
+                }
+            }
+            start.elapsed().as_secs_f64() * 1e9 / built.max(1) as f64
+        })
+        .collect();
+    median(&timings)
+}
+
+fn main() -> Result<(), Error> {
+    let args = Args::parse();
+    let stride = args.stride.max(1);
+    let source = RaySource::Files(args.rays.clone());
+    let scenes = load_scenes(&args.scenes, &args.scene_names, &source)?;
+    println!("scene    rays        setup ns  ours  pre-built  Embree  ours/Embree per round: median (min-max)");
+    for scene in &scenes {
+        for set in &scene.ray_sets {
+            let setup = construction_ns(set, stride, args.rounds);
+            let opts = RunOptions { stride, runs: 1 };
+            let row = rounds::run(scene, set, opts, args.rounds, true)?;
+            let ours = median(&row.ours_mrays);
+            let prebuilt = median(&row.ours_prebuilt_mrays);
+            let versus = row
+                .vs_embree()
+                .map_or("no Embree in this build".to_string(), |p| {
+                    let (lo, hi) = p.ratio_range();
+                    format!(
+                        "{:5.2}  {:.3} ({lo:.3}-{hi:.3})",
+                        p.peer_median,
+                        p.median_ratio()
+                    )
+                });
+            println!(
+                "{:8} {:10} {setup:9.1}  {ours:4.2}  {prebuilt:9.2}  {versus}",
+                scene.name,
+                set.kind.name()
+            );
+        }
+    }
+    Ok(())
+}
