@@ -10,14 +10,12 @@
 //! ```
 
 use clap::Parser;
-use host::trace::median;
-use raykernel::Ray;
+use host::trace::{median, prepare_rays};
 use raykernel_bench::error::Error;
 use raykernel_bench::ours::RunOptions;
 use raykernel_bench::rounds;
 use raykernel_bench::workload::{load_scenes, RaySet, RaySource};
 use std::path::PathBuf;
-use std::time::Instant;
 
 /// Interleaved rounds of the headline structure against Embree, without the rest of the
 /// benchmark.
@@ -40,19 +38,13 @@ struct Args {
     rounds: usize,
 }
 
-/// Median ns per ray of `Ray::from_f32` over every `stride`-th record, in `rounds` timings.
+/// Median ns per ray of the report's ray setup ([`prepare_rays`]: `Ray::from_f32` on every
+/// `stride`-th record, into a vector) over `rounds` timings.
 fn construction_ns(set: &RaySet, stride: usize, rounds: usize) -> f64 {
     let timings: Vec<f64> = (0..rounds.max(1))
         .map(|_| {
-            let start = Instant::now();
-            let mut built = 0usize;
-            for r in set.records.iter().step_by(stride) {
-                if let Ok(ray) = Ray::<f32>::from_f32(r.origin, r.dir, r.t_min, r.t_max) {
-                    std::hint::black_box(&ray);
-                    built += 1;
-                }
-            }
-            start.elapsed().as_secs_f64() * 1e9 / built.max(1) as f64
+            let prepared = prepare_rays::<f32>(&set.records, stride);
+            prepared.setup_ms * 1e6 / prepared.rays.len().max(1) as f64
         })
         .collect();
     median(&timings)

@@ -6,7 +6,8 @@
 # usage: host/scripts/check_isa.sh RAYS_DIR
 #
 # RAYS_DIR as for check_trace.sh. Environment: HOST_BIN (the baseline binary; default: build
-# target/release/raykernel), SCENES (default "bunny sponza kitchen"), STRIDE (default 8).
+# target/release/raykernel), SCENES (default "bunny sponza kitchen"), SCENES_DIR (default
+# ../shared/scenes beside the workspace), STRIDE (every STRIDE-th ray; default 8).
 # Prints "skipped" and exits 0 on a CPU without AVX2 (the v3 binary could not run there).
 set -euo pipefail
 
@@ -18,7 +19,7 @@ rays_dir=$1
 root=$(cd "$(dirname "$0")/../.." && pwd)
 scenes=${SCENES:-bunny sponza kitchen}
 stride=${STRIDE:-8}
-scenes_dir=$root/../shared/scenes
+scenes_dir=${SCENES_DIR:-$root/../shared/scenes}
 
 if ! grep -qw avx2 /proc/cpuinfo 2>/dev/null; then
     echo "skipped: this CPU has no AVX2, so an x86-64-v3 build cannot run here"
@@ -40,15 +41,11 @@ for scene in $scenes; do
     for kind in primary incoherent; do
         rays=$rays_dir/$scene.$kind.rays
         [ -f "$rays" ] || { echo "missing $rays" >&2; exit 2; }
-        # Every STRIDE-th record, so the check stays short.
-        python3 -c "
-import sys
-data = open(sys.argv[1], 'rb').read()
-open(sys.argv[2], 'wb').write(b''.join(data[i:i + 32] for i in range(0, len(data), 32 * int(sys.argv[3]))))
-" "$rays" "$out/rays" "$stride"
         for mode in f32 fixed; do
-            "$HOST_BIN" trace -q --mode "$mode" --out "$out/base.hits" "$scenes_dir/$scene.obj" "$out/rays" >/dev/null
-            "$v3_bin" trace -q --mode "$mode" --out "$out/v3.hits" "$scenes_dir/$scene.obj" "$out/rays" >/dev/null
+            "$HOST_BIN" trace -q --mode "$mode" --stride "$stride" --out "$out/base.hits" \
+                "$scenes_dir/$scene.obj" "$rays" >/dev/null
+            "$v3_bin" trace -q --mode "$mode" --stride "$stride" --out "$out/v3.hits" \
+                "$scenes_dir/$scene.obj" "$rays" >/dev/null
             if cmp -s "$out/base.hits" "$out/v3.hits"; then
                 echo "$scene $kind $mode: x86-64-v3 build identical ($(($(stat -c %s "$out/base.hits") / 8)) rays)"
             else
