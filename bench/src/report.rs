@@ -466,12 +466,13 @@ fn headline_section(s: &mut String, r: &BenchResults) {
          their conversion time is added to their trace time. `pre-built` is raykernel tracing \
          rays constructed ahead (traversal alone). Ours is raykernel `f32`, the 4-wide BVH \
          collapsed from the SAH BVH, watertight; ratios are ours per ray ÷ peer: above 1 means \
-         ours is faster.\n"
+         ours is faster. `fixed ÷ f32` is the same structure in fixed point per ray, ray \
+         construction included, against `f32`.\n"
     );
     let mut head =
-        "| scene | triangles | rays | raykernel f32 | raykernel f32 pre-built | raykernel fixed |"
+        "| scene | triangles | rays | raykernel f32 | raykernel f32 pre-built | raykernel fixed | fixed ÷ f32 |"
             .to_string();
-    let mut rule = "|---|---:|---|---:|---:|---:|".to_string();
+    let mut rule = "|---|---:|---|---:|---:|---:|---:|".to_string();
     for p in &peers {
         let _ = write!(head, " {p} | ratio |");
         rule.push_str("---:|---:|");
@@ -484,12 +485,13 @@ fn headline_section(s: &mut String, r: &BenchResults) {
             };
             let fixed = fixed_reference(&r.rows, &scene, kind);
             let mut line = format!(
-                "| {scene} | {} | {} | {:.2} | {} | {} |",
+                "| {scene} | {} | {} | {:.2} | {} | {} | {} |",
                 ours.triangles,
                 kind.name(),
                 ours.closest_mrays,
                 opt(ours.closest_mrays_prebuilt, 2),
-                fixed.map_or("-".into(), |f| format!("{:.2}", f.closest_mrays))
+                fixed.map_or("-".into(), |f| format!("{:.2}", f.closest_mrays)),
+                fixed.map_or("-".into(), |f| ratio(f.closest_mrays, ours.closest_mrays))
             );
             for p in &peers {
                 match r

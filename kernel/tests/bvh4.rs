@@ -41,6 +41,10 @@ fn direction(rng: &mut Rng) -> [f32; 3] {
     d
 }
 
+// Fixed point's 4-wide box test runs in `f32` lanes where there are vector lanes and is
+// conservative rather than equal to `slab` there: tested against exact rational distances in
+// `scalar/fixed.rs` (`slab4_is_conservative_and_tight`). Elsewhere it is `slab` per box.
+
 fn slab4_cases<S: TestScalar>() {
     let mut rng = Rng::new(0x51ab_4444);
     let (mut accepted, mut rejected) = (0usize, 0usize);
@@ -109,11 +113,6 @@ fn slab4_equals_slab_per_box_f32() {
     slab4_cases::<f32>();
 }
 
-#[test]
-fn slab4_equals_slab_per_box_fixed() {
-    slab4_cases::<I16F16>();
-}
-
 /// Rays along the axes with ±0 components, on and off the faces of a unit box: every slab4
 /// lane agrees with slab (the 0 · inf = NaN paths of `f32`).
 fn slab4_axis_cases<S: TestScalar>() {
@@ -167,11 +166,6 @@ fn slab4_axis_cases<S: TestScalar>() {
 #[test]
 fn slab4_equals_slab_on_axis_rays_f32() {
     slab4_axis_cases::<f32>();
-}
-
-#[test]
-fn slab4_equals_slab_on_axis_rays_fixed() {
-    slab4_axis_cases::<I16F16>();
 }
 
 /// The reason unused slots are masked by `count`: an inverted box (`lo = +inf`, `hi = -inf`)

@@ -9,7 +9,10 @@
 //!   by a gap (no fallback needed, unlike `f32`);
 //! - hit distance: `t = floor(T·2^30 / det)` in `i128` (deterministic, not exact);
 //! - slab test: `(plane - origin) · (2^62 / d) >> 32` in `i128`, padded by 2 raw units each way,
-//!   which bounds the rounding of the reciprocal, so boxes are never culled wrongly.
+//!   which bounds the rounding of the reciprocal, so boxes are never culled wrongly. The 4-wide
+//!   BVH's test of four boxes at once runs in `f32` lanes where there are vector lanes
+//!   (`wide::slab4_fixed`: exact `i32` plane distances, relative margins), which may visit
+//!   other nodes than the integer test would but finds the same hits.
 
 use super::sealed::Numerics;
 use super::Scalar;
@@ -63,13 +66,35 @@ impl I16F16 {
     /// Rounds `x` to nearest (ties away from zero), saturating; NaN gives zero.
     #[must_use]
     pub fn from_f32(x: f32) -> Self {
-        // f64 holds x·65536 exactly; `as i32` saturates and maps NaN to 0.
-        Self(libm::round(x as f64 * ONE_RAW as f64) as i32)
+        // f64 holds x·65536 exactly; the rounding saturates and maps NaN to 0.
+        let raw = round_half_away(x as f64 * ONE_RAW as f64);
+        Self(raw.clamp(i32::MIN as i64, i32::MAX as i64) as i32)
     }
     /// Converts to `f32`, rounding to nearest (exact when `|raw| < 2^24`).
     #[must_use]
     pub fn to_f32(self) -> f32 {
         (self.0 as f64 / ONE_RAW as f64) as f32
+    }
+}
+
+/// `libm::round(v) as i64`: the nearest integer, ties away from zero, saturating, NaN to 0.
+///
+/// Hosted targets add the largest `f64` below one half, with `v`'s sign, and truncate: below
+/// 2^52 the sum reaches the next integer (in magnitude) exactly when `v`'s fraction is at
+/// least one half (at one half it falls at most half an ulp short and rounds onto it; just
+/// below, it stays short), and from 2^52 on every `f64` is an integer that the sum rounds back
+/// to. Two instructions instead of `libm::round`'s bit manipulation, which held up every
+/// ray's construction. Bare-metal targets keep `libm::round`: no `f64` arithmetic there.
+#[inline(always)]
+fn round_half_away(v: f64) -> i64 {
+    #[cfg(not(target_os = "none"))]
+    {
+        const BELOW_HALF: f64 = 0.499_999_999_999_999_94;
+        (v + libm::copysign(BELOW_HALF, v)) as i64
+    }
+    #[cfg(target_os = "none")]
+    {
+        libm::round(v) as i64
     }
 }
 
@@ -186,6 +211,13 @@ pub struct FixedRay {
     o_lo: [i64; 3],
     /// Origin as seen from the boxes' `hi` planes: one raw unit down.
     o_hi: [i64; 3],
+    /// `2^30 / dir` rounded to `f32` (`+inf` for a zero component): the reciprocal the
+    /// 4-wide box test reads where it runs in vector lanes (`wide::slab4_fixed`).
+    #[cfg(any(
+        target_feature = "sse2",
+        all(target_arch = "aarch64", target_feature = "neon")
+    ))]
+    inv_lanes: [f32; 3],
 }
 
 fn check_raw(x: i32) -> Result<(), PointError> {
@@ -199,7 +231,7 @@ fn check_raw(x: i32) -> Result<(), PointError> {
 }
 
 impl FixedRay {
-    #[inline]
+    #[cfg_attr(not(target_os = "none"), inline(always))]
     fn new(origin: [I16F16; 3], unit: [f64; 3]) -> Result<Self, RayError> {
         for x in origin {
             check_raw(x.0).map_err(RayError::Origin)?;
@@ -212,18 +244,38 @@ impl FixedRay {
             // The box grows by one raw unit on each side, as seen from these origins.
             o_lo: o.map(|x| x + 1),
             o_hi: o.map(|x| x - 1),
+            #[cfg(any(
+                target_feature = "sse2",
+                all(target_arch = "aarch64", target_feature = "neon")
+            ))]
+            inv_lanes: [0.0; 3],
         };
         r.set_dir(unit);
         Ok(r)
     }
 
     /// Sets the direction (Q2.30, rounded from `unit`) and its reciprocals.
-    #[inline]
+    #[cfg_attr(not(target_os = "none"), inline(always))]
     fn set_dir(&mut self, unit: [f64; 3]) {
-        self.dir = unit.map(|u| libm::round(u * DIR_ONE) as i64);
+        self.dir = unit.map(|u| round_half_away(u * DIR_ONE));
         self.recip = self
             .dir
             .map(|d| if d == 0 { i64::MAX } else { (1i64 << 62) / d });
+        #[cfg(any(
+            target_feature = "sse2",
+            all(target_arch = "aarch64", target_feature = "neon")
+        ))]
+        {
+            // `d as f32` and the quotient round: two relative errors of 2^-24 at most.
+            const DIR_ONE_F32: f32 = (1u32 << 30) as f32;
+            self.inv_lanes = self.dir.map(|d| {
+                if d == 0 {
+                    f32::INFINITY
+                } else {
+                    DIR_ONE_F32 / d as f32
+                }
+            });
+        }
     }
 
     fn moved(&self, origin: [I16F16; 3]) -> Result<Self, RayError> {
@@ -338,7 +390,7 @@ impl Numerics for I16F16 {
         let unit = super::float::unit_dir_f64([dir[0].0 as f64, dir[1].0 as f64, dir[2].0 as f64])?;
         FixedRay::new(origin, unit)
     }
-    #[inline]
+    #[cfg_attr(not(target_os = "none"), inline(always))]
     fn ray_data_from_f32(origin: [f32; 3], dir: [f32; 3]) -> Result<FixedRay, RayError> {
         let mut o = [I16F16::ZERO; 3];
         for i in 0..3 {
@@ -382,6 +434,33 @@ impl Numerics for I16F16 {
         } else {
             None
         }
+    }
+
+    #[cfg(any(
+        target_feature = "sse2",
+        all(target_arch = "aarch64", target_feature = "neon")
+    ))]
+    #[inline(always)]
+    fn slab4(
+        r: &FixedRay,
+        lo: &[[Self; 4]; 3],
+        hi: &[[Self; 4]; 3],
+        t_min: Self,
+        t_max: Self,
+    ) -> (u32, [Self; 4]) {
+        let raw = |planes: &[[Self; 4]; 3]| planes.map(|axis| axis.map(|x| x.0));
+        let o_lo = r.o_lo.map(|x| x as i32); // |origin| <= 2^29: the shifted ones fit
+        let o_hi = r.o_hi.map(|x| x as i32);
+        let (mask, t) = super::wide::slab4_fixed(
+            o_lo,
+            o_hi,
+            r.inv_lanes,
+            &raw(lo),
+            &raw(hi),
+            t_min.0,
+            t_max.0,
+        );
+        (mask, t.map(I16F16))
     }
 
     #[inline(always)]
@@ -503,5 +582,196 @@ mod tests {
         let r = FixedRay::new([I16F16::ZERO; 3], [0.6, 0.8, 0.0]).unwrap();
         assert_eq!(r.dir, [644_245_094, 858_993_459, 0]);
         assert_eq!(r.recip[2], i64::MAX);
+    }
+
+    /// The tests' xorshift generator: advances `state` and returns it.
+    fn next(state: &mut u64) -> u64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        *state
+    }
+
+    #[test]
+    fn rounding_matches_libm_round() {
+        let edges = [
+            0.5,
+            0.499_999_999_999_999_94,
+            0.500_000_000_000_000_1,
+            1.5,
+            2.5,
+            -2.5,
+            4_503_599_627_370_495.5,
+            4_503_599_627_370_496.0,
+            9_007_199_254_740_993.0,
+            1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            f64::MIN_POSITIVE,
+            0.0,
+            -0.0,
+        ];
+        let check = |v: f64| {
+            for v in [v, -v] {
+                let want = libm::round(v) as i64;
+                assert_eq!(round_half_away(v), want, "{v:e} ({:#x})", v.to_bits());
+            }
+        };
+        edges.into_iter().for_each(check);
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..200_000 {
+            let bits = next(&mut state);
+            // Arbitrary bit patterns, and values a few ulps from halves of integers below 2^31
+            // and from one half.
+            check(f64::from_bits(bits));
+            let ulps = (bits & 7) as i64 - 3;
+            let near = |x: f64| f64::from_bits((x.to_bits() as i64 + ulps) as u64);
+            check(near((bits >> 33) as f64 + 0.5));
+            check(near(0.5));
+        }
+    }
+
+    /// Whether the ray meets the box `[lo - grow, hi + grow]` at a `t` (raw units, real) in
+    /// `[t_lo, t_hi]`, and if so the least such `t` as a fraction `(num, den)`; exact, in
+    /// `i128`.
+    fn meets(
+        r: &FixedRay,
+        lo: [i64; 3],
+        hi: [i64; 3],
+        grow: i64,
+        t_lo: i64,
+        t_hi: i64,
+    ) -> Option<(i128, i128)> {
+        // Fractions num/den with den > 0; `first` is the running lower end, `last` the upper.
+        let (mut first, mut last) = ((t_lo as i128, 1i128), (t_hi as i128, 1i128));
+        let less = |a: (i128, i128), b: (i128, i128)| a.0 * b.1 < b.0 * a.1;
+        for k in 0..3 {
+            let (l, h, o, d) = (lo[k] - grow, hi[k] + grow, r.origin[k], r.dir[k]);
+            if d == 0 {
+                if o < l || o > h {
+                    return None;
+                }
+                continue;
+            }
+            // t = (plane - o)·2^30 / d.
+            let den = d.unsigned_abs() as i128;
+            let sign = d.signum() as i128;
+            let ta = ((l - o) as i128 * (1 << 30) * sign, den);
+            let tb = ((h - o) as i128 * (1 << 30) * sign, den);
+            let (near, far) = if less(tb, ta) { (tb, ta) } else { (ta, tb) };
+            if less(first, near) {
+                first = near;
+            }
+            if less(far, last) {
+                last = far;
+            }
+        }
+        (!less(last, first)).then_some(first)
+    }
+
+    /// The float-lane box test of the 4-wide BVH accepts every box the ray meets within
+    /// `[t_min, t_max + 1]` (where a hit reported at `t_max` can lie), with an entry no later
+    /// than the exact one, and accepts no box it misses by more than its margins.
+    #[cfg(any(
+        target_feature = "sse2",
+        all(target_arch = "aarch64", target_feature = "neon")
+    ))]
+    #[test]
+    fn slab4_is_conservative_and_tight() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let (mut met, mut missed) = (0, 0);
+        for case in 0..50_000 {
+            let coord = |state: &mut u64| {
+                let bits = next(state);
+                let scale = 1i64 << (4 + bits % 26); // raw 2^4 .. 2^29
+                (((bits >> 8) as i64 % (2 * scale + 1)) - scale).clamp(-(1 << 29), 1 << 29)
+            };
+            let origin = [0; 3].map(|_| I16F16(coord(&mut state) as i32));
+            let mut d = [0.0f64; 3];
+            for x in &mut d {
+                let bits = next(&mut state);
+                *x = match bits % 8 {
+                    0 => 0.0,
+                    1 => (bits >> 12) as f64 * 1e-30, // tiny components: huge reciprocals
+                    _ => (bits >> 11) as f64 / (1u64 << 53) as f64 - 0.5,
+                };
+            }
+            let Ok(unit) = crate::scalar::float::unit_dir_f64(d) else {
+                continue;
+            };
+            let r = FixedRay::new(origin, unit).expect("origin in range");
+            let (mut lo, mut hi) = ([[I16F16(0); 4]; 3], [[I16F16(0); 4]; 3]);
+            let mut boxes = [([0i64; 3], [0i64; 3]); 4];
+            for (b, (bl, bh)) in boxes.iter_mut().enumerate() {
+                // Half the boxes have planes near a point of the ray (which grazes or enters
+                // them), the others near the origin or anywhere; some are flat.
+                let along = next(&mut state);
+                let t_on = (next(&mut state) >> (34 + along % 30)) as i128;
+                for k in 0..3 {
+                    let bits = next(&mut state);
+                    let on_ray = r.origin[k] + ((t_on * r.dir[k] as i128) >> 30) as i64;
+                    let pick = |state: &mut u64, side: i64| match (along % 2, bits % 4) {
+                        (0, _) => on_ray + side * ((next(state) % 5) as i64 - 1),
+                        (_, 0) => r.origin[k] + (next(state) % 5) as i64 - 2,
+                        _ => coord(state),
+                    };
+                    let x = pick(&mut state, -1);
+                    let y = if bits % 7 == 0 {
+                        x
+                    } else {
+                        pick(&mut state, 1)
+                    };
+                    (bl[k], bh[k]) = (x.min(y), x.max(y));
+                    lo[k][b] = I16F16(bl[k] as i32);
+                    hi[k][b] = I16F16(bh[k] as i32);
+                }
+            }
+            let t_pick = |bits: u64| match bits % 4 {
+                0 => 0,
+                1 | 2 => i32::MAX,
+                _ => (bits >> (34 + (bits >> 8) % 30)) as i32,
+            };
+            let (a, b) = (t_pick(next(&mut state)), t_pick(next(&mut state)));
+            let (t_min, t_max) = (a.min(b), a.max(b));
+            let (mask, t) = I16F16::slab4(&r, &lo, &hi, I16F16(t_min), I16F16(t_max));
+            for (i, &(bl, bh)) in boxes.iter().enumerate() {
+                let accepted = mask & (1 << i) != 0;
+                let (t_min, t_max) = (i64::from(t_min), i64::from(t_max));
+                if let Some((num, den)) = meets(&r, bl, bh, 0, t_min, t_max + 1) {
+                    met += 1;
+                    assert!(accepted, "case {case} box {i}: missed");
+                    assert!(
+                        i128::from(t[i].0) * den <= num,
+                        "case {case} box {i}: entry {} after {num}/{den}",
+                        t[i].0
+                    );
+                } else {
+                    missed += 1;
+                }
+                if accepted {
+                    // Margins: a relative 2^-18 of the distances involved, plus two raw units.
+                    let reach = (0..3)
+                        .flat_map(|k| [bl[k], bh[k]].map(|p| (p - r.origin[k]).abs()))
+                        .max()
+                        .unwrap_or(0);
+                    let grow = 3 + (reach >> 18);
+                    let slack = |t: i64| (t >> 18) + 1;
+                    let near = meets(
+                        &r,
+                        bl,
+                        bh,
+                        grow,
+                        t_min - slack(t_min),
+                        t_max + 3 + slack(t_max),
+                    );
+                    assert!(
+                        near.is_some(),
+                        "case {case} box {i}: accepted, far off the ray"
+                    );
+                }
+            }
+        }
+        assert!(met > 10_000 && missed > 10_000, "{met} {missed}");
     }
 }

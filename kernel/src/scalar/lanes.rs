@@ -18,9 +18,10 @@ mod sse {
     // every bit pattern is a valid `f32`; `clamped_trunc`'s copies an `__m128i` into a
     // `[u32; 4]`, where every bit pattern is valid too.
     use arch::{
-        __m128, __m128i, _mm_add_ps, _mm_cmple_ps, _mm_cvtss_f32, _mm_cvttps_epi32, _mm_div_ps,
-        _mm_max_ps, _mm_min_ps, _mm_movehl_ps, _mm_movemask_ps, _mm_mul_ps, _mm_set1_ps,
-        _mm_setr_ps, _mm_shuffle_ps, _mm_sub_ps, _mm_unpackhi_ps, _mm_unpacklo_ps,
+        __m128, __m128i, _mm_add_ps, _mm_cmple_ps, _mm_cvtepi32_ps, _mm_cvtss_f32,
+        _mm_cvttps_epi32, _mm_div_ps, _mm_loadu_si128, _mm_max_ps, _mm_min_ps, _mm_movehl_ps,
+        _mm_movemask_ps, _mm_mul_ps, _mm_set1_epi32, _mm_set1_ps, _mm_setr_ps, _mm_shuffle_ps,
+        _mm_sub_epi32, _mm_sub_ps, _mm_unpackhi_ps, _mm_unpacklo_ps,
     };
     #[cfg(target_arch = "x86")]
     use core::arch::x86 as arch;
@@ -61,6 +62,15 @@ mod sse {
         pub(crate) fn to_array(self) -> [f32; 4] {
             unsafe { core::mem::transmute::<__m128, [f32; 4]>(self.0) }
         }
+        /// Per lane `a.wrapping_sub(b) as f32` (rounded to nearest).
+        #[inline(always)]
+        pub(crate) fn from_i32_difference(a: &[i32; 4], b: i32) -> Self {
+            // SAFETY: see above; the unaligned load reads the 16 bytes of `a`.
+            Self(unsafe {
+                let a = _mm_loadu_si128(a.as_ptr().cast::<__m128i>());
+                _mm_cvtepi32_ps(_mm_sub_epi32(a, _mm_set1_epi32(b)))
+            })
+        }
         /// Per lane `if a < b { a } else { b }` (the second operand when unordered).
         #[inline(always)]
         pub(crate) fn min(self, o: Self) -> Self {
@@ -86,8 +96,8 @@ mod sse {
         pub(crate) fn high_half(self) -> Self {
             Self(unsafe { _mm_movehl_ps(self.0, self.0) })
         }
-        /// Per lane `(x as i32).clamp(0, top)` for a whole `top` in `0..=2^24`: the lane
-        /// clamped to `[0, top]` (NaN to 0), then truncated, which is exact in that range.
+        /// Per lane `(x as i32).clamp(0, top)` for a whole `top` in `0..2^31`: the lane clamped
+        /// to `[0, top]` (NaN to 0), then truncated (a floor there; exact up to 2^24).
         #[inline(always)]
         pub(crate) fn clamped_trunc(self, top: f32) -> [u32; 4] {
             let x = self.max(Self::splat(0.0)).min(Self::splat(top));
@@ -124,9 +134,9 @@ mod neon {
     // `u32` of a local array, which is valid, aligned and initialised.
     use core::arch::aarch64::{
         float32x4_t, uint32x4_t, vaddq_f32, vaddvq_u32, vandq_u32, vbslq_f32, vcgtq_f32, vcleq_f32,
-        vcltq_f32, vcltzq_s32, vcombine_f32, vcvtq_u32_f32, vdivq_f32, vdupq_n_f32, vget_high_f32,
-        vgetq_lane_f32, vld1q_f32, vld1q_u32, vmulq_f32, vreinterpretq_s32_f32, vst1q_f32,
-        vst1q_u32, vsubq_f32, vzip1q_f32, vzip2q_f32,
+        vcltq_f32, vcltzq_s32, vcombine_f32, vcvtq_f32_s32, vcvtq_u32_f32, vdivq_f32, vdupq_n_f32,
+        vdupq_n_s32, vget_high_f32, vgetq_lane_f32, vld1q_f32, vld1q_s32, vld1q_u32, vmulq_f32,
+        vreinterpretq_s32_f32, vst1q_f32, vst1q_u32, vsubq_f32, vsubq_s32, vzip1q_f32, vzip2q_f32,
     };
 
     /// Four lanes in a NEON register.
@@ -172,6 +182,12 @@ mod neon {
             unsafe { vst1q_f32(out.as_mut_ptr(), self.0) };
             out
         }
+        /// Per lane `a.wrapping_sub(b) as f32` (rounded to nearest).
+        #[inline(always)]
+        pub(crate) fn from_i32_difference(a: &[i32; 4], b: i32) -> Self {
+            // SAFETY: see above; the load reads the four `i32` of `a`.
+            Self(unsafe { vcvtq_f32_s32(vsubq_s32(vld1q_s32(a.as_ptr()), vdupq_n_s32(b))) })
+        }
         /// Per lane `if a < b { a } else { b }` (the second operand when unordered).
         #[inline(always)]
         pub(crate) fn min(self, o: Self) -> Self {
@@ -197,8 +213,8 @@ mod neon {
         pub(crate) fn high_half(self) -> Self {
             Self(unsafe { vcombine_f32(vget_high_f32(self.0), vget_high_f32(self.0)) })
         }
-        /// Per lane `(x as i32).clamp(0, top)` for a whole `top` in `0..=2^24`: the lane
-        /// clamped to `[0, top]` (NaN to 0), then truncated, which is exact in that range.
+        /// Per lane `(x as i32).clamp(0, top)` for a whole `top` in `0..2^31`: the lane clamped
+        /// to `[0, top]` (NaN to 0), then truncated (a floor there; exact up to 2^24).
         #[inline(always)]
         pub(crate) fn clamped_trunc(self, top: f32) -> [u32; 4] {
             let x = self.max(Self::splat(0.0)).min(Self::splat(top));
@@ -282,6 +298,13 @@ mod portable {
         #[inline(always)]
         pub(crate) fn to_array(self) -> [f32; 4] {
             self.0
+        }
+        /// Only the vector backends' callers need it (`wide::slab4_fixed`); here for the
+        /// comparison test.
+        #[cfg(test)]
+        #[inline(always)]
+        pub(crate) fn from_i32_difference(a: &[i32; 4], b: i32) -> Self {
+            Self(a.map(|x| x.wrapping_sub(b) as f32))
         }
         #[inline(always)]
         pub(crate) fn min(self, o: Self) -> Self {
@@ -407,7 +430,15 @@ mod tests {
             assert_eq!(pa.sign_mask(), sa.sign_mask(), "sign_mask {a:?}");
             same(P::splat(a[0]), S::splat(a[0]), "splat");
             assert_eq!(pa.le_mask(pb), sa.le_mask(sb), "le_mask {a:?} {b:?}");
-            for top in [0.0, 3.0, 31.0, 16_777_216.0] {
+            // Integer differences that wrap and that round (beyond 2^24) when converted.
+            let ints = a.map(|x| x.to_bits() as i32);
+            let by = b[0].to_bits() as i32 >> (k % 32);
+            same(
+                P::from_i32_difference(&ints, by),
+                S::from_i32_difference(&ints, by),
+                "from_i32_difference",
+            );
+            for top in [0.0, 3.0, 31.0, 16_777_216.0, 2_147_483_520.0] {
                 assert_eq!(
                     pa.clamped_trunc(top),
                     sa.clamped_trunc(top),

@@ -89,12 +89,15 @@ pub(crate) mod sealed {
         }
         /// `Numerics::slab` of four boxes at once (a 4-wide BVH node's children), given as
         /// structure of arrays: `lo[axis][box]`, `hi[axis][box]`. Returns a mask (bit `i` set if box
-        /// `i` is accepted) and the entry distances; for every accepted box the distance has the
-        /// same bits as `slab` gives, and the accept/reject decisions are `slab`'s. Entries of
-        /// rejected boxes are unspecified.
+        /// `i` is accepted) and the entry distances. Entries of rejected boxes are unspecified.
         ///
-        /// The default runs `slab` per box; `f32` computes the four boxes in the lanes of
-        /// one vector (`scalar/wide.rs`), with each lane doing `slab`'s operations in its order.
+        /// The default runs `slab` per box. `f32` computes the four boxes in the lanes of one
+        /// vector (`scalar/wide.rs`), with each lane doing `slab`'s operations in its order:
+        /// decisions and entries are `slab`'s, bit for bit. Fixed point where `F4` has vector
+        /// lanes runs a conservative `f32` version of its test in them (`wide::slab4_fixed`):
+        /// every box the ray meets within `[t_min, t_max + 1]` is accepted with an entry no later
+        /// than the exact one, so the hits are the same, but decisions and entries may differ
+        /// from `slab`'s.
         #[inline(always)]
         fn slab4(
             ray: &Self::RayData,

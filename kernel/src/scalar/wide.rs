@@ -1,13 +1,18 @@
-//! The `f32` slab test of four boxes at once, one box per lane of an [`F4`]: the box test of a
+//! The slab test of four boxes at once, one box per lane of an [`F4`]: the box test of a
 //! 4-wide BVH node (`accel/bvh4`).
 //!
-//! Each lane performs exactly the operations of `Numerics::slab` for `f32` (`float.rs`) on its
-//! box, in the same order: per axis `a = (lo - o_lo) * inv`, `b = (hi - o_hi) * inv`,
-//! `near = min(a, b)`, `far = max(a, b)` (SSE semantics: the second operand when unordered);
-//! then `t_near = max(near_z, max(near_y, max(near_x, t_min)))`, `t_far` likewise with `min`
-//! from `t_max`, and the box is accepted if `t_near <= t_far * widen`. So every lane's
-//! decision and entry distance have the bits `slab` gives for that box (tested on random
-//! boxes and rays in `kernel/tests/bvh4.rs`).
+//! `f32` ([`slab4`]): each lane performs exactly the operations of `Numerics::slab` for `f32`
+//! (`float.rs`) on its box, in the same order: per axis `a = (lo - o_lo) * inv`,
+//! `b = (hi - o_hi) * inv`, `near = min(a, b)`, `far = max(a, b)` (SSE semantics: the second
+//! operand when unordered); then `t_near = max(near_z, max(near_y, max(near_x, t_min)))`,
+//! `t_far` likewise with `min` from `t_max`, and the box is accepted if
+//! `t_near <= t_far * widen`. So every lane's decision and entry distance have the bits `slab`
+//! gives for that box (tested on random boxes and rays in `kernel/tests/bvh4.rs`).
+//!
+//! Fixed point ([`slab4_fixed`], where `F4` has vector lanes): the same steps in `f32` lanes on
+//! exact integer plane distances, with relative margins that make the test conservative. Its
+//! decisions may differ from the integer `slab` (24 `i128` products per node, the larger part
+//! of fixed-point traversal time on a 64-bit host), never its hits.
 
 use super::lanes::F4;
 
@@ -42,4 +47,63 @@ pub(super) fn slab4(
     let t_far = far_z.min(far_y.min(far_x.min(F4::splat(t_max))));
     let mask = t_near.le_mask(t_far.mul(F4::splat(widen)));
     (mask, t_near.to_array())
+}
+
+/// `Numerics::slab4` for fixed point where [`F4`] has vector lanes: the four boxes' raw Q16.16
+/// planes against the ray's shifted raw origins `o_lo`, `o_hi` (see `FixedRay`), with `inv`
+/// the reciprocal direction `2^30 / dir` rounded to `f32`; distances in raw Q16.16 units.
+///
+/// Conservative, not equal to `slab`: per lane and axis the plane distance is an exact `i32`
+/// difference, rounded once to `f32`, times `inv` (rounded twice), so each of `a`, `b` is
+/// within a relative `4·2^-24` of the exact `(plane − o)·2^30 / dir`, with its sign. The entry
+/// `max(t_min, near…)` is scaled down by `1 − 2^-20` and the exit `min(t_max + 2, far…)` up by
+/// `1 + 2^-20`, which outweighs those errors and the rounding of the scaling itself: whenever the
+/// ray meets the box (grown by one raw unit, as the shifted origins make it) at an exact `t`
+/// in `[t_min, t_max + 2]`, the box is accepted and its entry is at most `t`. A hit's
+/// distance is its exact one rounded down, so no box holding a hit up to `t_max` (with `t_max`
+/// the best hit so far) is culled, and none is popped too late: the entry is at most the
+/// exact `t`, less than the reported one plus one. Negative ends keep their sign under the
+/// scalings, and zero direction components behave as in the `f32` test (`0·inf = NaN` makes
+/// an axis unconstraining, never a box missed). Rejected lanes' entries are unspecified.
+///
+/// Decisions and entries may differ from `slab`'s integer test (which pads by two raw units
+/// instead); hits do not, as the differential tests check. Targets without vector lanes use
+/// `slab` per box.
+#[allow(clippy::too_many_arguments)]
+#[cfg(any(
+    target_feature = "sse2",
+    all(target_arch = "aarch64", target_feature = "neon")
+))]
+#[inline(always)]
+pub(super) fn slab4_fixed(
+    o_lo: [i32; 3],
+    o_hi: [i32; 3],
+    inv: [f32; 3],
+    lo: &[[i32; 4]; 3],
+    hi: &[[i32; 4]; 3],
+    t_min: i32,
+    t_max: i32,
+) -> (u32, [i32; 4]) {
+    const SHRINK: f32 = 1.0 - 1.0 / 1_048_576.0;
+    const GROW: f32 = 1.0 + 1.0 / 1_048_576.0;
+    // The largest `f32` below 2^31: entries are clamped to it before conversion to raw `i32`.
+    const ENTRY_TOP: f32 = 2_147_483_520.0;
+    let axis = |k: usize| {
+        let k = k.min(2); // a no-op that shows the compiler the bound
+        let inv = F4::splat(inv[k]);
+        // Unused slots (inverted boxes at the range ends) may wrap here: masked by the caller.
+        let a = F4::from_i32_difference(&lo[k], o_lo[k]).mul(inv);
+        let b = F4::from_i32_difference(&hi[k], o_hi[k]).mul(inv);
+        (a.min(b), a.max(b))
+    };
+    let (near_x, far_x) = axis(0);
+    let (near_y, far_y) = axis(1);
+    let (near_z, far_z) = axis(2);
+    let t_near = near_z.max(near_y.max(near_x.max(F4::splat(t_min as f32))));
+    let t_far = far_z.min(far_y.min(far_x.min(F4::splat(t_max as f32 + 2.0))));
+    let t_near = t_near.mul(F4::splat(SHRINK));
+    let mask = t_near.le_mask(t_far.mul(F4::splat(GROW)));
+    // Accepted entries lie in [0, 2^31]: truncation is a floor there.
+    let t = t_near.clamped_trunc(ENTRY_TOP);
+    (mask, t.map(|x| x as i32))
 }
