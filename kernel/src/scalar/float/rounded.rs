@@ -16,7 +16,8 @@
 //!   within `2^-50·K` of `t`.
 //! - The result is accepted only if the interval of relative half-width `2^-32·K` around the
 //!   `f64` quotient (over `2^9` times both errors) holds no midpoint: then both give the `f32`
-//!   nearest to `t`. Also refused: `det` within `2^-20·S` of zero (so neither solve divides by
+//!   nearest to `t`. (Tested multiplied through by `|det|`, which saves two divisions; the
+//!   few roundings of that test are far inside the factor `2^9`.) Also refused: `det` within `2^-20·S` of zero (so neither solve divides by
 //!   a cancelled value), a zero or non-finite result (signs of zeros, overflow).
 
 const CONDITION: f64 = 1.0 / 1_048_576.0; // 2^-20
@@ -43,7 +44,6 @@ pub(super) fn certified_t(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> Option<f3
     if t32 == 0.0 || !t32.is_finite() {
         return None;
     }
-    let bound = t.abs() * RELATIVE * (1.0 + z / num.abs() + s / det.abs());
     // The midpoints towards both neighbours (`bits - 1` is nearer zero, `bits + 1` farther;
     // an infinite neighbour only makes that half-gap infinite).
     let bits = t32.to_bits();
@@ -51,5 +51,9 @@ pub(super) fn certified_t(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> Option<f3
     let nearer = (at - f64::from(f32::from_bits(bits - 1))).abs();
     let farther = (f64::from(f32::from_bits(bits + 1)) - at).abs();
     let half_gap = nearer.min(farther) * 0.5;
-    ((t - at).abs() + bound < half_gap).then_some(t32)
+    // `|t - at| + |t|·RELATIVE·K < half_gap`, multiplied through by `|det|` (using
+    // `|t|·|det| = |num|`): one division per candidate instead of three.
+    let d = det.abs();
+    let bound = RELATIVE * (num.abs() + z + t.abs() * s);
+    ((t - at).abs() * d + bound < half_gap * d).then_some(t32)
 }
