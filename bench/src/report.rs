@@ -575,9 +575,10 @@ fn construction_table(s: &mut String, r: &BenchResults) {
     let _ = writeln!(
         s,
         "### Ray construction, ns per ray\n\n\
-         `Ray::from_f32` on every record ahead of tracing (normalisation in `f64`, reciprocals, \
-         shear constants, margins), timed apart: the difference between the per-ray and the \
-         pre-built figures above, measured on its own.\n"
+         `Ray::from_f32` on every record ahead of tracing (normalisation, reciprocals, shear \
+         constants, margins; fixed point also rounds to its formats), written into a new \
+         vector, timed apart. In the per-ray loop no vector is written and part of the work \
+         overlaps traversal, so the per-ray and pre-built figures above differ by less.\n"
     );
     let _ = writeln!(s, "| scene | rays | f32 | fixed |\n|---|---|---:|---:|");
     for scene in scenes(&r.rows) {
@@ -620,7 +621,10 @@ fn rounds_section(s: &mut String, r: &BenchResults) {
          contender of a round, so the per-round ratio is the robust comparison: ours per ray ÷ \
          Embree (both pay their ray setup), ours pre-built ÷ tinybvh (neither does). `best` is \
          the fastest round: noise from other tenants only adds time, so it is the figure least \
-         disturbed by them (Chen and Revels 2016).{}\n",
+         disturbed by them (Chen and Revels 2016). Embree's AVX kernels return with the upper \
+         halves of the vector registers in use, which slows the SSE code timed after them \
+         until something clears them: the harness clears them (`vzeroupper`) after every \
+         Embree call, outside its timing.{}\n",
         first.ours_mrays.len(),
         if missing.is_empty() {
             String::new()
