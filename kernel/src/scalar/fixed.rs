@@ -66,9 +66,8 @@ impl I16F16 {
     /// Rounds `x` to nearest (ties away from zero), saturating; NaN gives zero.
     #[must_use]
     pub fn from_f32(x: f32) -> Self {
-        // f64 holds x·65536 exactly; the rounding saturates and maps NaN to 0.
-        let raw = round_half_away(x as f64 * ONE_RAW as f64);
-        Self(raw.clamp(i32::MIN as i64, i32::MAX as i64) as i32)
+        // f64 holds x·65536 exactly; `as i32` saturates and maps NaN to 0.
+        Self(to_round(x as f64 * ONE_RAW as f64) as i32)
     }
     /// Converts to `f32`, rounding to nearest (exact when `|raw| < 2^24`).
     #[must_use]
@@ -77,24 +76,25 @@ impl I16F16 {
     }
 }
 
-/// `libm::round(v) as i64`: the nearest integer, ties away from zero, saturating, NaN to 0.
+/// A value that an `as` conversion to an integer turns into `libm::round(v)` (nearest, ties away
+/// from zero; `as` then saturates and maps NaN to 0).
 ///
-/// Hosted targets add the largest `f64` below one half, with `v`'s sign, and truncate: below
-/// 2^52 the sum reaches the next integer (in magnitude) exactly when `v`'s fraction is at
+/// Hosted targets add the largest `f64` below one half, with `v`'s sign, for `as` to truncate:
+/// below 2^52 the sum reaches the next integer (in magnitude) exactly when `v`'s fraction is at
 /// least one half (at one half it falls at most half an ulp short and rounds onto it; just
 /// below, it stays short), and from 2^52 on every `f64` is an integer that the sum rounds back
-/// to. Two instructions instead of `libm::round`'s bit manipulation, which held up every
-/// ray's construction. Bare-metal targets keep `libm::round`: no `f64` arithmetic there.
+/// to. One addition instead of `libm::round`'s bit manipulation, which held up every ray's
+/// construction. Bare-metal targets keep `libm::round`: no `f64` arithmetic there.
 #[inline(always)]
-fn round_half_away(v: f64) -> i64 {
+fn to_round(v: f64) -> f64 {
     #[cfg(not(target_os = "none"))]
     {
         const BELOW_HALF: f64 = 0.499_999_999_999_999_94;
-        (v + libm::copysign(BELOW_HALF, v)) as i64
+        v + libm::copysign(BELOW_HALF, v)
     }
     #[cfg(target_os = "none")]
     {
-        libm::round(v) as i64
+        libm::round(v)
     }
 }
 
@@ -232,6 +232,7 @@ fn check_raw(x: i32) -> Result<(), PointError> {
 
 impl FixedRay {
     #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline)]
     fn new(origin: [I16F16; 3], unit: [f64; 3]) -> Result<Self, RayError> {
         for x in origin {
             check_raw(x.0).map_err(RayError::Origin)?;
@@ -256,8 +257,9 @@ impl FixedRay {
 
     /// Sets the direction (Q2.30, rounded from `unit`) and its reciprocals.
     #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline)]
     fn set_dir(&mut self, unit: [f64; 3]) {
-        self.dir = unit.map(|u| round_half_away(u * DIR_ONE));
+        self.dir = unit.map(|u| to_round(u * DIR_ONE) as i64);
         self.recip = self
             .dir
             .map(|d| if d == 0 { i64::MAX } else { (1i64 << 62) / d });
@@ -391,6 +393,7 @@ impl Numerics for I16F16 {
         FixedRay::new(origin, unit)
     }
     #[cfg_attr(not(target_os = "none"), inline(always))]
+    #[cfg_attr(target_os = "none", inline)]
     fn ray_data_from_f32(origin: [f32; 3], dir: [f32; 3]) -> Result<FixedRay, RayError> {
         let mut o = [I16F16::ZERO; 3];
         for i in 0..3 {
@@ -614,8 +617,9 @@ mod tests {
         ];
         let check = |v: f64| {
             for v in [v, -v] {
-                let want = libm::round(v) as i64;
-                assert_eq!(round_half_away(v), want, "{v:e} ({:#x})", v.to_bits());
+                let (wide, narrow) = (libm::round(v) as i64, libm::round(v) as i32);
+                assert_eq!(to_round(v) as i64, wide, "{v:e} ({:#x})", v.to_bits());
+                assert_eq!(to_round(v) as i32, narrow, "{v:e} ({:#x})", v.to_bits());
             }
         };
         edges.into_iter().for_each(check);
