@@ -57,14 +57,15 @@ pub(super) fn slab4(
 /// difference, rounded once to `f32`, times `inv` (rounded twice), so each of `a`, `b` is
 /// within a relative `4·2^-24` of the exact `(plane − o)·2^30 / dir`, with its sign. The entry
 /// `max(t_min, near…)` is scaled down by `1 − 2^-20` and the exit `min(t_max + 2, far…)` up by
-/// `1 + 2^-20`, which outweighs those errors and the rounding of the scaling itself: whenever the
-/// ray meets the box (grown by one raw unit, as the shifted origins make it) at an exact `t`
-/// in `[t_min, t_max + 2]`, the box is accepted and its entry is at most `t`. A hit's
-/// distance is its exact one rounded down, so no box holding a hit up to `t_max` (with `t_max`
-/// the best hit so far) is culled, and none is popped too late: the entry is at most the
-/// exact `t`, less than the reported one plus one. Negative ends keep their sign under the
-/// scalings, and zero direction components behave as in the `f32` test (`0·inf = NaN` makes
-/// an axis unconstraining, never a box missed). Rejected lanes' entries are unspecified.
+/// `1 + 2^-20`, which outweighs those errors and the rounding of the scaling itself (the shifted
+/// origins and the `+ 2` only add slack): whenever the ray meets the box at an exact `t` in
+/// `[t_min, t_max + 1]`, the box is accepted and its entry is at most `t`. A hit's distance is
+/// its exact one rounded down, so no box holding a hit up to `t_max` (the best hit so far) is
+/// culled, and none is popped too late: its entry is at most the hit's exact `t`, less than the
+/// reported one plus one. Negative ends keep their sign under the scalings. A zero direction
+/// component gives infinite plane distances, and `0·inf = NaN` (an origin one raw unit outside
+/// a face) resolves by the `min`/`max` operand order as in the `f32` test, never to a miss of
+/// a box the ray meets. Rejected lanes' entries are unspecified.
 ///
 /// Decisions and entries may differ from `slab`'s integer test (which pads by two raw units
 /// instead); hits do not, as the differential tests check. Targets without vector lanes use
