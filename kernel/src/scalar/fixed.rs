@@ -269,12 +269,11 @@ impl FixedRay {
         ))]
         {
             // `d as f32` and the quotient round: two relative errors of 2^-24 at most.
-            const DIR_ONE_F32: f32 = (1u32 << 30) as f32;
             self.inv_lanes = self.dir.map(|d| {
                 if d == 0 {
                     f32::INFINITY
                 } else {
-                    DIR_ONE_F32 / d as f32
+                    DIR_ONE as f32 / d as f32
                 }
             });
         }
@@ -587,13 +586,7 @@ mod tests {
         assert_eq!(r.recip[2], i64::MAX);
     }
 
-    /// The tests' xorshift generator: advances `state` and returns it.
-    fn next(state: &mut u64) -> u64 {
-        *state ^= *state << 13;
-        *state ^= *state >> 7;
-        *state ^= *state << 17;
-        *state
-    }
+    use crate::scalar::xorshift as next;
 
     #[test]
     fn rounding_matches_libm_round() {

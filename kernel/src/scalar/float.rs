@@ -746,13 +746,7 @@ mod tests {
         assert!(step(0.0, true) > 0.0 && step(0.0, false) < 0.0);
     }
 
-    /// The tests' xorshift generator: advances `state` and returns it.
-    fn next(state: &mut u64) -> u64 {
-        *state ^= *state << 13;
-        *state ^= *state >> 7;
-        *state ^= *state << 17;
-        *state
-    }
+    use crate::scalar::xorshift as next;
 
     /// The next representable value above (`up`) or below `x`.
     fn step(x: f32, up: bool) -> f32 {

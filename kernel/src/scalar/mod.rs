@@ -14,6 +14,15 @@ mod float;
 pub(crate) mod lanes;
 mod wide;
 
+/// The unit tests' xorshift generator: advances `state` and returns it.
+#[cfg(test)]
+pub(crate) fn xorshift(state: &mut u64) -> u64 {
+    *state ^= *state << 13;
+    *state ^= *state >> 7;
+    *state ^= *state << 17;
+    *state
+}
+
 pub use error::{PointError, RayError};
 pub use fixed::{Vec3x, FIXED_COORD_LIMIT, I16F16};
 pub use float::F32_COORD_LIMIT;

@@ -16,6 +16,25 @@
 
 use super::lanes::F4;
 
+/// Entry and exit of four boxes from each axis's plane distances `(a, b)` (`axis(k)`, `k` in
+/// `0..3`): per axis `near = min(a, b)`, `far = max(a, b)`, then
+/// `t_near = max(near_z, max(near_y, max(near_x, t_min)))` and `t_far` likewise with `min`
+/// from `t_max`. The order is `slab`'s, which decides the NaN cases (SSE `min`/`max` return the
+/// second operand when unordered), so both lane tests share it.
+#[inline(always)]
+fn enter_exit(axis: impl Fn(usize) -> (F4, F4), t_min: f32, t_max: f32) -> (F4, F4) {
+    let near_far = |k: usize| {
+        let (a, b) = axis(k);
+        (a.min(b), a.max(b))
+    };
+    let (near_x, far_x) = near_far(0);
+    let (near_y, far_y) = near_far(1);
+    let (near_z, far_z) = near_far(2);
+    let t_near = near_z.max(near_y.max(near_x.max(F4::splat(t_min))));
+    let t_far = far_z.min(far_y.min(far_x.min(F4::splat(t_max))));
+    (t_near, t_far)
+}
+
 /// `Numerics::slab4` for `f32`: `o_lo`, `o_hi`, `inv` are the ray's shifted origins and
 /// reciprocal direction (lanes x, y, z, z), `widen` the far-end factor; boxes in structure of
 /// arrays `lo[axis][box]`.
@@ -38,13 +57,9 @@ pub(super) fn slab4(
         let a = l.sub(F4::splat(o_lo[k])).mul(inv);
         let b = h.sub(F4::splat(o_hi[k])).mul(inv);
         // See `slab_pair` in float.rs for the NaN cases (0 * inf): the same per lane here.
-        (a.min(b), a.max(b))
+        (a, b)
     };
-    let (near_x, far_x) = axis(0);
-    let (near_y, far_y) = axis(1);
-    let (near_z, far_z) = axis(2);
-    let t_near = near_z.max(near_y.max(near_x.max(F4::splat(t_min))));
-    let t_far = far_z.min(far_y.min(far_x.min(F4::splat(t_max))));
+    let (t_near, t_far) = enter_exit(axis, t_min, t_max);
     let mask = t_near.le_mask(t_far.mul(F4::splat(widen)));
     (mask, t_near.to_array())
 }
@@ -95,13 +110,9 @@ pub(super) fn slab4_fixed(
         // Unused slots (inverted boxes at the range ends) may wrap here: masked by the caller.
         let a = F4::from_i32_difference(&lo[k], o_lo[k]).mul(inv);
         let b = F4::from_i32_difference(&hi[k], o_hi[k]).mul(inv);
-        (a.min(b), a.max(b))
+        (a, b)
     };
-    let (near_x, far_x) = axis(0);
-    let (near_y, far_y) = axis(1);
-    let (near_z, far_z) = axis(2);
-    let t_near = near_z.max(near_y.max(near_x.max(F4::splat(t_min as f32))));
-    let t_far = far_z.min(far_y.min(far_x.min(F4::splat(t_max as f32 + 2.0))));
+    let (t_near, t_far) = enter_exit(axis, t_min as f32, t_max as f32 + 2.0);
     let t_near = t_near.mul(F4::splat(SHRINK));
     let mask = t_near.le_mask(t_far.mul(F4::splat(GROW)));
     // Accepted entries lie in [0, 2^31]: truncation is a floor there.

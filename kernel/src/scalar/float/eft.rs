@@ -205,12 +205,7 @@ pub(crate) fn exact_sum_sign(terms: &mut [f32]) -> f32 {
 mod tests {
     use super::*;
 
-    fn next(state: &mut u64) -> u64 {
-        *state ^= *state << 13;
-        *state ^= *state >> 7;
-        *state ^= *state << 17;
-        *state
-    }
+    use crate::scalar::xorshift as next;
 
     /// A random f32 of random sign with exponent in `[-exp, exp]`.
     fn value(state: &mut u64, exp: i32) -> f32 {

@@ -17,8 +17,9 @@
 //! - The result is accepted only if the interval of relative half-width `2^-32·K` around the
 //!   `f64` quotient (over `2^9` times both errors) holds no midpoint: then both give the `f32`
 //!   nearest to `t`. (Tested multiplied through by `|det|`, which saves two divisions; the
-//!   few roundings of that test are far inside the factor `2^9`.) Also refused: `det` within `2^-20·S` of zero (so neither solve divides by
-//!   a cancelled value), a zero or non-finite result (signs of zeros, overflow).
+//!   few roundings of that test are far inside the factor `2^9`.) Also refused: `det` within
+//!   `2^-20·S` of zero (so neither solve divides by a cancelled value), a zero or non-finite
+//!   result (signs of zeros, overflow).
 
 const CONDITION: f64 = 1.0 / 1_048_576.0; // 2^-20
 const RELATIVE: f64 = 1.0 / 4_294_967_296.0; // 2^-32
