@@ -576,9 +576,12 @@ fn construction_table(s: &mut String, r: &BenchResults) {
         s,
         "### Ray construction, ns per ray\n\n\
          `Ray::from_f32` on every record ahead of tracing (normalisation, reciprocals, shear \
-         constants, margins; fixed point also rounds to its formats), written into a new \
-         vector, timed apart. In the per-ray loop no vector is written and part of the work \
-         overlaps traversal, so the per-ray and pre-built figures above differ by less.\n"
+         constants, margins; fixed point also rounds to its formats), stored into a vector \
+         filled beforehand (so its page faults are not counted), timed apart. In the per-ray \
+         loop nothing is stored and part of the work overlaps traversal: the per-ray and \
+         pre-built figures above differ by what the loop pays. Before and after the construction work \
+         (`f32` set up in `f64` before), measured in alternation with the CLI built at both \
+         commits: [CONSTRUCTION.md](CONSTRUCTION.md), from `bench/scripts/construction.py`.\n"
     );
     let _ = writeln!(s, "| scene | rays | f32 | fixed |\n|---|---|---:|---:|");
     for scene in scenes(&r.rows) {

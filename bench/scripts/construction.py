@@ -1,0 +1,185 @@
+#!/usr/bin/env python3
+"""Ray construction per ray, before and after, measured in one alternating run.
+
+usage: construction.py --rays DIR [--before-rev REV] [--before-bin BIN] [--after-bin BIN]
+                       [--scenes DIR] [--city-dir DIR] [--stride 8] [--runs 3] [--rounds 3]
+                       [--out docs/bench/CONSTRUCTION.md]
+
+Runs `trace` of two builds of the CLI in alternation (before, after, before, ...) on every
+scene, ray set and mode, with the 4-wide BVH from the SAH BVH, and writes a Markdown table.
+`--before-bin` defaults to a build of `--before-rev` (default f5262d3, the last commit whose
+`f32` rays were set up in `f64`), made in a temporary git worktree with the current
+`prepare_rays` spliced in; `--after-bin` defaults to `target/release/raykernel`. Both builds
+then time ray construction the same way (every traced record turned into a kernel ray and
+stored into a vector touched beforehand, timed apart from tracing), so the "construction"
+columns compare the kernels' constructors; "in the loop" is what the current
+per-ray loop pays over tracing pre-built rays (per ray minus pre-built), which the before build
+cannot measure (it had no per-ray loop: a caller paid construction plus tracing).
+"""
+import argparse
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import tempfile
+from datetime import date
+
+SCENES = ["bunny", "sponza", "kitchen"]
+
+
+def cpu_name():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown CPU"
+
+
+def prepare_rays_fn(text, path):
+    """The `prepare_rays` function in `text` (the host's trace.rs) as (start, end) offsets."""
+    start = text.find("pub fn prepare_rays<")
+    end = text.find("\n}\n", start)
+    if start < 0 or end < 0:
+        sys.exit(f"no prepare_rays in {path}")
+    return start, end + 3
+
+
+def build_before(rev, repo):
+    """Builds the CLI at `rev` in a temporary worktree, with the current `prepare_rays` (the
+    harness that times construction) spliced in, so both builds time it alike; returns the
+    binary's path."""
+    work = tempfile.mkdtemp(prefix="raykernel-before-")
+    tree = os.path.join(work, "tree")
+    target = os.path.join(work, "target")
+    subprocess.run(["git", "-C", repo, "worktree", "add", "-q", "--detach", tree, rev], check=True)
+    try:
+        current_path = os.path.join(repo, "host/src/trace.rs")
+        old_path = os.path.join(tree, "host/src/trace.rs")
+        with open(current_path) as f:
+            current = f.read()
+        with open(old_path) as f:
+            old = f.read()
+        a, b = prepare_rays_fn(current, current_path)
+        c, d = prepare_rays_fn(old, old_path)
+        with open(old_path, "w") as f:
+            f.write(old[:c] + current[a:b] + old[d:])
+        subprocess.run(["cargo", "build", "--release", "-q", "-p", "raykernel-host"],
+                       cwd=tree, env={**os.environ, "CARGO_TARGET_DIR": target}, check=True)
+    finally:
+        subprocess.run(["git", "-C", repo, "worktree", "remove", "--force", tree], check=False)
+    for name in ("raykernel", "host"):
+        path = os.path.join(target, "release", name)
+        if os.path.exists(path):
+            return path
+    sys.exit(f"no CLI binary in {target}/release after building {rev}")
+
+
+def trace(binary, scene, rays, mode, stride, runs):
+    """One `trace` run; returns its JSON summary."""
+    out = tempfile.NamedTemporaryFile(suffix=".hits", delete=False).name
+    cmd = [binary, "trace", scene, rays, "--out", out, "--mode", mode, "--accel", "bvh4",
+           "--stride", str(stride), "--runs", str(runs)]
+    res = subprocess.run(cmd, capture_output=True, text=True, check=True)
+    os.unlink(out)
+    lines = [l for l in res.stdout.splitlines() if l.startswith("{")]
+    if not lines:
+        sys.exit(f"no JSON from {' '.join(cmd)}")
+    return json.loads(lines[-1])
+
+
+def ns(ms, rays):
+    return ms * 1e6 / rays
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--rays", required=True, help="ray files from make_rays.py --out DIR")
+    ap.add_argument("--scenes", default="../shared/scenes")
+    ap.add_argument("--city-dir", help="city.obj and its ray files (make_tiled.py, make_rays.py)")
+    ap.add_argument("--before-rev", default="f5262d3")
+    ap.add_argument("--before-bin")
+    ap.add_argument("--after-bin", default="target/release/raykernel")
+    ap.add_argument("--stride", type=int, default=8)
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--out", default="docs/bench/CONSTRUCTION.md")
+    args = ap.parse_args()
+
+    repo = subprocess.run(["git", "rev-parse", "--show-toplevel"], capture_output=True,
+                          text=True, check=True).stdout.strip()
+    after_rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
+                               text=True, check=True).stdout.strip()
+    before = args.before_bin or build_before(args.before_rev, repo)
+    after = args.after_bin
+    if not os.path.exists(after):
+        sys.exit(f"{after} not found: cargo build --release -p raykernel-host")
+
+    sets = [(s, os.path.join(args.scenes, f"{s}.obj"), args.rays) for s in SCENES]
+    if args.city_dir:
+        sets.append(("city", os.path.join(args.city_dir, "city.obj"), args.city_dir))
+    rows = []
+    for name, obj, ray_dir in sets:
+        for kind in ("primary", "incoherent"):
+            rays = os.path.join(ray_dir, f"{name}.{kind}.rays")
+            if not (os.path.exists(obj) and os.path.exists(rays)):
+                print(f"skipped: {name} {kind} ({obj} or {rays} missing)", file=sys.stderr)
+                continue
+            for mode in ("f32", "fixed"):
+                b_setup, a_setup, ratio, a_loop, b_total, a_per_ray = [], [], [], [], [], []
+                for _ in range(args.rounds):
+                    b = trace(before, obj, rays, mode, args.stride, args.runs)
+                    a = trace(after, obj, rays, mode, args.stride, args.runs)
+                    n = a["rays"]
+                    bs, as_ = ns(b["setup_ms"], b["rays"]), ns(a["setup_ms"], n)
+                    b_setup.append(bs)
+                    a_setup.append(as_)
+                    ratio.append(as_ / bs)
+                    a_loop.append(ns(a["per_ray_ms"] - a["trace_ms"], n))
+                    b_total.append(ns(b["setup_ms"] + b["trace_ms"], b["rays"]))
+                    a_per_ray.append(ns(a["per_ray_ms"], n))
+                med = statistics.median
+                rows.append((name, kind, mode, med(b_setup), med(a_setup), med(ratio),
+                             med(a_loop), med(b_total), med(a_per_ray)))
+                print(name, kind, mode, [round(x, 1) for x in rows[-1][3:]], file=sys.stderr)
+
+    lines = [
+        "# Ray construction, before and after",
+        "",
+        f"machine: {cpu_name()}, {os.cpu_count()} cores; date: {date.today().isoformat()}",
+        "",
+        f"- command: `python3 bench/scripts/construction.py --rays {args.rays}"
+        + (f" --city-dir {args.city_dir}" if args.city_dir else "")
+        + f" --stride {args.stride} --runs {args.runs} --rounds {args.rounds}`",
+        f"- before: the CLI built at `{args.before_rev}` (`f32` rays normalised in `f64`); "
+        f"after: the CLI built at `{after_rev}`",
+        f"- 4-wide BVH from the SAH BVH, every {args.stride}th ray, {args.rounds} rounds "
+        f"alternating before and after, each the median of {args.runs} runs; the table gives "
+        "medians over the rounds (the ratio is the median of per-round ratios)",
+        "",
+        "`construction` is the current `prepare_rays` in both builds (spliced into the before "
+        "build): every record turned into a kernel ray and stored into a vector whose pages "
+        "were touched beforehand, timed apart from tracing. `in the loop` is what the "
+        "current per-ray loop pays for construction: per ray minus pre-built, both traced in "
+        "the same run. `per ray` is what a caller pays per query: before, construction and "
+        "tracing one after the other (the before build had no per-ray loop); after, the "
+        "per-ray loop.",
+        "",
+        "| scene | rays | mode | construction before ns | construction after ns | after ÷ before "
+        "| in the loop after ns | per ray before ns | per ray after ns |",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    for (name, kind, mode, bs, as_, r, loop, bt, apr) in rows:
+        lines.append(f"| {name} | {kind} | {mode} | {bs:.1f} | {as_:.1f} | {r:.2f}× "
+                     f"| {loop:.1f} | {bt:.1f} | {apr:.1f} |")
+    with open(args.out, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print(f"wrote {args.out}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
