@@ -5,8 +5,8 @@
 //! - [`workload`]: scenes and the WORKLOAD.md ray sets (files from `make_rays.py`, or
 //!   generated), the city from `make_tiled.py`,
 //! - [`ours`]: the kernel's contenders (every accelerator, builder and mode, plus the
-//!   benchmark-only Möller–Trumbore contrast of [`mt`]); the headline figure constructs each
-//!   ray from its record inside the timed loop, the pre-built figure beside it does not,
+//!   benchmark-only Möller–Trumbore contrast of [`mt`]); the headline figure sets the
+//!   ray from each record inside the timed loop, the pre-built figure beside it does not,
 //! - [`peers`]: Embree 3 (HIGH and MEDIUM, `embree` feature, through [`embree`]), tinybvh
 //!   (`tinybvh` feature), `obvhs` (BVH2, CWBVH) and `bvh`, measured in the same run,
 //! - [`rounds`]: the headline contender, Embree and tinybvh traced in alternation, round by

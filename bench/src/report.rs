@@ -460,8 +460,9 @@ fn headline_section(s: &mut String, r: &BenchResults) {
     );
     let _ = writeln!(
         s,
-        "What a caller pays per query: raykernel constructs each kernel ray from the record's raw \
-         `f32` origin, direction and interval inside the timed loop, and Embree's \
+        "What a caller pays per query: raykernel sets one kernel ray from each record's raw `f32` \
+         origin, direction and interval inside the timed loop (`Ray::set_from_f32`, in place, \
+         as a caller fills Embree's ray structure), and Embree's \
          `rtcIntersect1` takes the raw record; the other peers take rays converted ahead, so \
          their conversion time is added to their trace time. `pre-built` is raykernel tracing \
          rays constructed ahead (traversal alone). Ours is raykernel `f32`, the 4-wide BVH \
@@ -685,7 +686,7 @@ fn ours_section(s: &mut String, r: &BenchResults) {
         s,
         "BVH leaves of up to {} primitives (`bvh::DEFAULT_LEAF_SIZE`); `bvh4` is the 4-wide BVH \
          collapsed from the BVH of the same builder. `any hit` is `occluded` (first hit in \
-         range), timed once on the last run. `per ray` constructs each ray from its record in \
+         range), timed once on the last run. `per ray` sets the ray from each record in \
          the timed loop; `pre-built` traces rays constructed ahead (`ray setup ns` each). Nodes \
          and primitives are counted per closest-hit \
          ray (for `bvh4`, every child box tested counts as a node). Bytes per triangle count \

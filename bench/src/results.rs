@@ -11,7 +11,7 @@ use serde::Serialize;
 /// Figures of one contender (our kernel in one configuration, or a peer) on one ray set.
 ///
 /// Times are medians over the runs. `closest_mrays` and `any_mrays` are the per-ray figures,
-/// what a caller pays: ours and Embree construct each ray from its record inside the timed
+/// what a caller pays: ours and Embree prepare each ray from its record inside the timed
 /// loop; the other peers take rays converted ahead, so theirs add that conversion
 /// (`setup_ms`) to the trace time. `*_prebuilt` count tracing of rays built ahead only (ours
 /// and the peers that take pre-built rays; `None` for Embree, whose call takes raw records).

@@ -5,7 +5,7 @@
 //! The pieces are public so the benchmark reuses them rather than copying the loop:
 //! [`build_and_visit`] builds whichever kernel [`AccelKind`] is asked for (timed, through
 //! [`AnyAccel`]) and hands the structure itself to an [`AccelVisitor`];
-//! [`trace_closest_per_ray`] times queries that construct each ray from its record,
+//! [`trace_closest_per_ray`] times queries that set one ray from each record in turn,
 //! [`prepare_rays`] and [`trace_closest`] the two halves of a trace of pre-built rays.
 //!
 //! [`AccelKind::Bvh4`] builds the BVH (timed) and collapses it into the 4-wide tree (timed
@@ -128,8 +128,8 @@ pub struct BuildFigures {
 
 /// Figures of a trace: times are the medians over the runs.
 ///
-/// Two timings of the same closest-hit queries: `per_ray_ms` constructs each kernel ray from
-/// its record inside the timed loop (what a caller pays per ray), `trace_ms` traces rays
+/// Two timings of the same closest-hit queries: `per_ray_ms` sets one kernel ray from each
+/// record inside the timed loop (what a caller pays per ray), `trace_ms` traces rays
 /// constructed beforehand (`setup_ms`, timed apart) and so counts traversal alone.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TraceStats {
@@ -434,9 +434,9 @@ fn trace_rays<S: Scalar, A: Accel<S>>(
     (hits, stats)
 }
 
-/// Closest hit of every `stride`-th record, each kernel ray constructed from the record's raw
-/// origin, direction and interval inside the timed loop: what a caller pays per query. A
-/// record the kernel rejects is a miss. Returns the hits and the loop's wall time, ms.
+/// Closest hit of every `stride`-th record: one kernel ray, set from each record's raw origin,
+/// direction and interval ([`Ray::set_from_f32`], in place) inside the timed loop, then
+/// traced: what a caller pays per query. A record the kernel rejects is a miss. Returns the hits and the loop's wall time, ms.
 ///
 /// # Panics
 /// If `stride` is 0.
@@ -448,11 +448,12 @@ pub fn trace_closest_per_ray<S: Scalar, A: Accel<S>>(
 ) -> (Vec<HitRecord>, f64) {
     assert!(stride > 0, "stride must be at least 1");
     let mut hits = vec![HitRecord::MISS; rays.len().div_ceil(stride)];
+    let mut ray = placeholder::<S>();
     let start = Instant::now();
     for (slot, r) in hits.iter_mut().zip(rays.iter().step_by(stride)) {
-        let Ok(ray) = Ray::<S>::from_f32(r.origin, r.dir, r.t_min, r.t_max) else {
+        if ray.set_from_f32(r.origin, r.dir, r.t_min, r.t_max).is_err() {
             continue;
-        };
+        }
         if let Some(h) = accel.nearest(&ray) {
             *slot = HitRecord {
                 t: h.t.to_f32(),
@@ -463,8 +464,8 @@ pub fn trace_closest_per_ray<S: Scalar, A: Accel<S>>(
     (hits, millis(start))
 }
 
-/// Any hit (occlusion) of every `stride`-th record, each kernel ray constructed inside the
-/// timed loop as in [`trace_closest_per_ray`]. Returns how many are occluded and the loop's
+/// Any hit (occlusion) of every `stride`-th record, the kernel ray set from each record inside
+/// the timed loop as in [`trace_closest_per_ray`]. Returns how many are occluded and the loop's
 /// wall time, ms.
 ///
 /// # Panics
@@ -476,14 +477,22 @@ pub fn occluded_per_ray<S: Scalar, A: Accel<S>>(
     stride: usize,
 ) -> (usize, f64) {
     assert!(stride > 0, "stride must be at least 1");
+    let mut ray = placeholder::<S>();
     let start = Instant::now();
     let mut occluded = 0usize;
     for r in rays.iter().step_by(stride) {
-        if let Ok(ray) = Ray::<S>::from_f32(r.origin, r.dir, r.t_min, r.t_max) {
+        if ray.set_from_f32(r.origin, r.dir, r.t_min, r.t_max).is_ok() {
             occluded += usize::from(accel.occluded(&ray));
         }
     }
     (std::hint::black_box(occluded), millis(start))
+}
+
+/// A ray valid in both modes: what a reused ray starts as, and what stands in for a record the
+/// kernel rejects.
+fn placeholder<S: Scalar>() -> Ray<S> {
+    Ray::from_f32([0.0; 3], [0.0, 0.0, 1.0], 0.0, 0.0)
+        .expect("the placeholder ray is valid in both modes")
 }
 
 /// Kernel rays made from ray-file records, one per traced record.
@@ -513,9 +522,7 @@ pub fn prepare_rays<S: Scalar>(rays: &[RayRecord], stride: usize) -> PreparedRay
     // place: the fill takes the page faults of fresh memory (most of the time of storing
     // 100+ bytes per ray), which are not ray construction. (One exact-size allocation:
     // growing a 100+ MB vector by reallocation measurably slowed the trace that follows.)
-    let placeholder = Ray::<S>::from_f32([0.0; 3], [0.0, 0.0, 1.0], 0.0, 0.0)
-        .expect("the placeholder ray is valid in both modes");
-    let mut prepared = vec![placeholder; rays.len().div_ceil(stride)];
+    let mut prepared = vec![placeholder::<S>(); rays.len().div_ceil(stride)];
     let mut bad = Vec::new();
     let start = Instant::now();
     for (i, (slot, r)) in prepared

@@ -720,3 +720,61 @@ proptest! {
         check_redirect::<I16F16>(o, first, d).map_err(TestCaseError::fail)?;
     }
 }
+
+/// `set_from_f32` must make the ray `Ray::from_f32` of the same arguments, bit for bit
+/// (compared through `Debug`), and leave it unchanged when that is an error (the same error).
+fn check_set<S: TestScalar>(
+    base: ([f32; 3], [f32; 3]),
+    o: [f32; 3],
+    d: [f32; 3],
+    (t_min, t_max): (f32, f32),
+) -> Result<(), String> {
+    use raykernel::Ray;
+    let Ok(mut ray) = Ray::<S>::from_f32(base.0, base.1, 0.0, f32::INFINITY) else {
+        return Ok(()); // an unusable starting ray: nothing to overwrite
+    };
+    let before = format!("{ray:?}");
+    let want = Ray::<S>::from_f32(o, d, t_min, t_max);
+    let got = ray.set_from_f32(o, d, t_min, t_max);
+    let (want, got) = match (want, got) {
+        (Ok(w), Ok(())) => (format!("{w:?}"), format!("{ray:?}")),
+        (Err(w), Err(g)) if w == g => (before, format!("{ray:?}")),
+        (w, g) => return Err(format!("{}: from_f32 {w:?}, set_from_f32 {g:?}", S::NAME)),
+    };
+    if want == got {
+        Ok(())
+    } else {
+        Err(format!("{}: want {want}\ngot {got}", S::NAME))
+    }
+}
+
+fn bound() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        4 => 0.0f32..100.0,
+        1 => Just(-1.0f32),
+        1 => Just(f32::NAN),
+        1 => Just(f32::INFINITY),
+    ]
+}
+
+proptest! {
+    #![proptest_config(config(2000))]
+
+    #[test]
+    fn set_rays_equal_fresh_ones(
+        base_o in prop::array::uniform3(-100.0f32..100.0),
+        base_d in prop::array::uniform3(component()),
+        o in prop::array::uniform3(prop_oneof![
+            8 => -9000.0f32..9000.0,
+            1 => Just(f32::NAN),
+            1 => Just(1e30f32),
+        ]),
+        d in prop::array::uniform3(component()),
+        t_min in bound(),
+        t_max in bound(),
+    ) {
+        let t = (t_min, t_max);
+        check_set::<f32>((base_o, base_d), o, d, t).map_err(TestCaseError::fail)?;
+        check_set::<I16F16>((base_o, base_d), o, d, t).map_err(TestCaseError::fail)?;
+    }
+}

@@ -182,26 +182,22 @@ pub(super) fn unit_dir_from_f32(d: [f32; 3]) -> Result<[f64; 3], RayError> {
     unit_dir_f64(d.map(f64::from))
 }
 
-impl FloatRay {
-    /// Inlined into the ray constructors: see `ray_data` in the `Scalar` impl below.
-    #[cfg_attr(not(target_os = "none"), inline(always))]
-    fn new(origin: [f32; 3], dir: [f32; 3]) -> Result<Self, RayError> {
-        for &x in &origin {
-            check_coord(x).map_err(RayError::Origin)?;
-        }
-        let (o_lo, o_hi) = Self::shifted_origins(origin);
-        Self::along(origin, o_lo, o_hi, dir)
-    }
+/// What a ray's data takes from its direction alone.
+struct Direction {
+    /// Unit direction.
+    dir: [f32; 3],
+    /// `1 / dir`, z repeated in lane 3.
+    inv: [f32; 4],
+    /// Watertight test: axis permutation (kx, ky, kz).
+    k: [Axis; 3],
+    /// Watertight test: shear constants Sx, Sy, Sz.
+    shear: [f32; 3],
+}
 
-    /// The ray from a checked origin (with its shifted copies) along `dir`: everything that
-    /// depends on the direction. Inlined as [`FloatRay::new`] is.
+impl Direction {
+    /// The data of the unit vector along `dir`. Inlined as [`FloatRay::new`] is.
     #[cfg_attr(not(target_os = "none"), inline(always))]
-    fn along(
-        origin: [f32; 3],
-        o_lo: [f32; 4],
-        o_hi: [f32; 4],
-        dir: [f32; 3],
-    ) -> Result<Self, RayError> {
+    fn of(dir: [f32; 3]) -> Result<Self, RayError> {
         let dir = unit_dir(dir)?;
         // Four quotients in one vector division (each lane the same IEEE quotient).
         let inv = F4::splat(1.0)
@@ -222,8 +218,42 @@ impl FloatRay {
             core::mem::swap(&mut kx, &mut ky);
         }
         let sz = inv[kz as usize]; // 1 / dir[kz], the same quotient
-        let shear = [axis(&dir, kx) * sz, axis(&dir, ky) * sz, sz];
-        let k = [kx, ky, kz];
+        Ok(Self {
+            dir,
+            inv,
+            k: [kx, ky, kz],
+            shear: [axis(&dir, kx) * sz, axis(&dir, ky) * sz, sz],
+        })
+    }
+}
+
+/// `v` permuted to the axes `k`.
+#[inline(always)]
+fn permuted(v: &[f32; 3], [kx, ky, kz]: [Axis; 3]) -> [f32; 3] {
+    [axis(v, kx), axis(v, ky), axis(v, kz)]
+}
+
+impl FloatRay {
+    /// Inlined into the ray constructors: see `ray_data` in the `Scalar` impl below.
+    #[cfg_attr(not(target_os = "none"), inline(always))]
+    fn new(origin: [f32; 3], dir: [f32; 3]) -> Result<Self, RayError> {
+        for &x in &origin {
+            check_coord(x).map_err(RayError::Origin)?;
+        }
+        let (o_lo, o_hi) = Self::shifted_origins(origin);
+        Self::along(origin, o_lo, o_hi, dir)
+    }
+
+    /// The ray from a checked origin (with its shifted copies) along `dir`: everything that
+    /// depends on the direction. Inlined as [`FloatRay::new`] is.
+    #[cfg_attr(not(target_os = "none"), inline(always))]
+    fn along(
+        origin: [f32; 3],
+        o_lo: [f32; 4],
+        o_hi: [f32; 4],
+        dir: [f32; 3],
+    ) -> Result<Self, RayError> {
+        let Direction { dir, inv, k, shear } = Direction::of(dir)?;
         Ok(Self {
             origin,
             dir,
@@ -232,8 +262,30 @@ impl FloatRay {
             o_hi,
             k,
             shear,
-            o_perm: [axis(&origin, kx), axis(&origin, ky), axis(&origin, kz)],
+            o_perm: permuted(&origin, k),
         })
+    }
+
+    /// [`FloatRay::new`] written into `self` field by field, unchanged on error (every check
+    /// comes first). Built in place, the ray is never moved: a caller that reuses one ray for
+    /// many queries does not read back a struct assembled from narrower stores, which stalls
+    /// on store forwarding.
+    #[cfg_attr(not(target_os = "none"), inline(always))]
+    fn set(&mut self, origin: [f32; 3], dir: [f32; 3]) -> Result<(), RayError> {
+        for &x in &origin {
+            check_coord(x).map_err(RayError::Origin)?;
+        }
+        let d = Direction::of(dir)?;
+        let (o_lo, o_hi) = Self::shifted_origins(origin);
+        self.origin = origin;
+        self.dir = d.dir;
+        self.inv = d.inv;
+        self.o_lo = o_lo;
+        self.o_hi = o_hi;
+        self.k = d.k;
+        self.shear = d.shear;
+        self.o_perm = permuted(&origin, d.k);
+        Ok(())
     }
 
     /// The origins the slab test sees (see the fields' docs), z repeated in lane 3, each
@@ -254,12 +306,11 @@ impl FloatRay {
             check_coord(x).map_err(RayError::Origin)?;
         }
         let (o_lo, o_hi) = Self::shifted_origins(origin);
-        let [kx, ky, kz] = self.k;
         Ok(Self {
             origin,
             o_lo,
             o_hi,
-            o_perm: [axis(&origin, kx), axis(&origin, ky), axis(&origin, kz)],
+            o_perm: permuted(&origin, self.k),
             ..*self
         })
     }
@@ -533,6 +584,14 @@ impl Numerics for f32 {
     #[cfg_attr(not(target_os = "none"), inline(always))]
     fn ray_data_from_f32(origin: [f32; 3], dir: [f32; 3]) -> Result<FloatRay, RayError> {
         FloatRay::new(origin, dir)
+    }
+    #[cfg_attr(not(target_os = "none"), inline(always))]
+    fn set_ray_data_from_f32(
+        data: &mut FloatRay,
+        origin: [f32; 3],
+        dir: [f32; 3],
+    ) -> Result<(), RayError> {
+        data.set(origin, dir)
     }
     fn ray_moved(ray: &FloatRay, origin: [f32; 3]) -> Result<FloatRay, RayError> {
         ray.moved(origin)

@@ -53,6 +53,17 @@ pub(crate) mod sealed {
         /// Prepares a ray from an `f32` origin and direction (for fixed point, the direction keeps
         /// more precision than a Q16.16 vector could carry).
         fn ray_data_from_f32(origin: [f32; 3], dir: [f32; 3]) -> Result<Self::RayData, RayError>;
+        /// [`Numerics::ray_data_from_f32`] written into `data`, which is unchanged on error. The
+        /// default moves the prepared data in; `f32` writes it field by field.
+        #[inline(always)]
+        fn set_ray_data_from_f32(
+            data: &mut Self::RayData,
+            origin: [f32; 3],
+            dir: [f32; 3],
+        ) -> Result<(), RayError> {
+            *data = Self::ray_data_from_f32(origin, dir)?;
+            Ok(())
+        }
         /// The same ray (direction bits unchanged) from another origin: motion blur moves rays
         /// into a moving object's frame this way.
         ///
