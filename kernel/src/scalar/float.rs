@@ -182,57 +182,6 @@ pub(super) fn unit_dir_from_f32(d: [f32; 3]) -> Result<[f64; 3], RayError> {
     unit_dir_f64(d.map(f64::from))
 }
 
-/// What a ray's data takes from its direction alone.
-struct Direction {
-    /// Unit direction.
-    dir: [f32; 3],
-    /// `1 / dir`, z repeated in lane 3.
-    inv: [f32; 4],
-    /// Watertight test: axis permutation (kx, ky, kz).
-    k: [Axis; 3],
-    /// Watertight test: shear constants Sx, Sy, Sz.
-    shear: [f32; 3],
-}
-
-impl Direction {
-    /// The data of the unit vector along `dir`. Inlined as [`FloatRay::new`] is.
-    #[cfg_attr(not(target_os = "none"), inline(always))]
-    fn of(dir: [f32; 3]) -> Result<Self, RayError> {
-        let dir = unit_dir(dir)?;
-        // Four quotients in one vector division (each lane the same IEEE quotient).
-        let inv = F4::splat(1.0)
-            .div(F4::new([dir[0], dir[1], dir[2], dir[2]]))
-            .to_array();
-
-        // Watertight test: kz is the dominant axis; swapping kx/ky keeps the winding.
-        let a = [abs(dir[0]), abs(dir[1]), abs(dir[2])];
-        let kz = if a[0] >= a[1] && a[0] >= a[2] {
-            Axis::X
-        } else if a[1] >= a[2] {
-            Axis::Y
-        } else {
-            Axis::Z
-        };
-        let (mut kx, mut ky) = kz.following();
-        if axis(&dir, kz) < 0.0 {
-            core::mem::swap(&mut kx, &mut ky);
-        }
-        let sz = inv[kz as usize]; // 1 / dir[kz], the same quotient
-        Ok(Self {
-            dir,
-            inv,
-            k: [kx, ky, kz],
-            shear: [axis(&dir, kx) * sz, axis(&dir, ky) * sz, sz],
-        })
-    }
-}
-
-/// `v` permuted to the axes `k`.
-#[inline(always)]
-fn permuted(v: &[f32; 3], [kx, ky, kz]: [Axis; 3]) -> [f32; 3] {
-    [axis(v, kx), axis(v, ky), axis(v, kz)]
-}
-
 impl FloatRay {
     /// Inlined into the ray constructors: see `ray_data` in the `Scalar` impl below.
     #[cfg_attr(not(target_os = "none"), inline(always))]
@@ -253,7 +202,28 @@ impl FloatRay {
         o_hi: [f32; 4],
         dir: [f32; 3],
     ) -> Result<Self, RayError> {
-        let Direction { dir, inv, k, shear } = Direction::of(dir)?;
+        let dir = unit_dir(dir)?;
+        // Four quotients in one vector division (each lane the same IEEE quotient).
+        let inv = F4::splat(1.0)
+            .div(F4::new([dir[0], dir[1], dir[2], dir[2]]))
+            .to_array();
+
+        // Watertight test: kz is the dominant axis; swapping kx/ky keeps the winding.
+        let a = [abs(dir[0]), abs(dir[1]), abs(dir[2])];
+        let kz = if a[0] >= a[1] && a[0] >= a[2] {
+            Axis::X
+        } else if a[1] >= a[2] {
+            Axis::Y
+        } else {
+            Axis::Z
+        };
+        let (mut kx, mut ky) = kz.following();
+        if axis(&dir, kz) < 0.0 {
+            core::mem::swap(&mut kx, &mut ky);
+        }
+        let sz = inv[kz as usize]; // 1 / dir[kz], the same quotient
+        let shear = [axis(&dir, kx) * sz, axis(&dir, ky) * sz, sz];
+        let k = [kx, ky, kz];
         Ok(Self {
             origin,
             dir,
@@ -262,29 +232,35 @@ impl FloatRay {
             o_hi,
             k,
             shear,
-            o_perm: permuted(&origin, k),
+            o_perm: [axis(&origin, kx), axis(&origin, ky), axis(&origin, kz)],
         })
     }
 
     /// [`FloatRay::new`] written into `self` field by field, unchanged on error (every check
-    /// comes first). Built in place, the ray is never moved: a caller that reuses one ray for
-    /// many queries does not read back a struct assembled from narrower stores, which stalls
-    /// on store forwarding.
+    /// comes first). The fields are stored one by one from the inlined constructor's values, so
+    /// the ray is never assembled elsewhere and moved: a caller that reuses one ray for many
+    /// queries does not read back a struct made of narrower stores, which stalls on store
+    /// forwarding.
     #[cfg_attr(not(target_os = "none"), inline(always))]
     fn set(&mut self, origin: [f32; 3], dir: [f32; 3]) -> Result<(), RayError> {
-        for &x in &origin {
-            check_coord(x).map_err(RayError::Origin)?;
-        }
-        let d = Direction::of(dir)?;
-        let (o_lo, o_hi) = Self::shifted_origins(origin);
+        let Self {
+            origin,
+            dir,
+            inv,
+            o_lo,
+            o_hi,
+            k,
+            shear,
+            o_perm,
+        } = Self::new(origin, dir)?;
         self.origin = origin;
-        self.dir = d.dir;
-        self.inv = d.inv;
+        self.dir = dir;
+        self.inv = inv;
         self.o_lo = o_lo;
         self.o_hi = o_hi;
-        self.k = d.k;
-        self.shear = d.shear;
-        self.o_perm = permuted(&origin, d.k);
+        self.k = k;
+        self.shear = shear;
+        self.o_perm = o_perm;
         Ok(())
     }
 
@@ -306,11 +282,12 @@ impl FloatRay {
             check_coord(x).map_err(RayError::Origin)?;
         }
         let (o_lo, o_hi) = Self::shifted_origins(origin);
+        let [kx, ky, kz] = self.k;
         Ok(Self {
             origin,
             o_lo,
             o_hi,
-            o_perm: permuted(&origin, self.k),
+            o_perm: [axis(&origin, kx), axis(&origin, ky), axis(&origin, kz)],
             ..*self
         })
     }
