@@ -9,7 +9,7 @@ Runs `trace` of two builds of the CLI in alternation (before, after, before, ...
 scene, ray set and mode, with the 4-wide BVH from the SAH BVH, and writes a Markdown table.
 `--before-bin` defaults to a build of `--before-rev` (default f5262d3, the last commit whose
 `f32` rays were set up in `f64`), made in a temporary git worktree with the current
-`prepare_rays` spliced in; `--after-bin` defaults to `target/release/raykernel`. Both builds
+`prepare_rays` (and the helpers it calls) spliced in; `--after-bin` defaults to `target/release/raykernel`. Both builds
 then time ray construction the same way (every traced record turned into a kernel ray and
 stored into a vector touched beforehand, timed apart from tracing), so the "construction"
 columns compare the kernels' constructors; "in the loop" is what the current
@@ -40,19 +40,43 @@ def cpu_name():
     return platform.processor() or "unknown CPU"
 
 
-def prepare_rays_fn(text, path):
-    """The `prepare_rays` function in `text` (the host's trace.rs) as (start, end) offsets."""
-    start = text.find("pub fn prepare_rays<")
-    end = text.find("\n}\n", start)
-    if start < 0 or end < 0:
-        sys.exit(f"no prepare_rays in {path}")
-    return start, end + 3
+# The harness that times construction, spliced from the current host into the before build:
+# `prepare_rays` and the helpers it calls (inserted before it where the before build lacks them).
+HARNESS = ["prepare_rays", "placeholder"]
+
+
+def function_span(text, name):
+    """The function `name` in `text` (the host's trace.rs) as (start, end) offsets, or None."""
+    for prefix in ("pub fn ", "fn "):
+        start = text.find(f"\n{prefix}{name}<")
+        if start >= 0:
+            end = text.find("\n}\n", start)
+            return start + 1, end + 3
+    return None
+
+
+def splice_harness(current, old, path):
+    """`old` with the current harness functions in place of its own."""
+    for name in HARNESS:
+        span = function_span(current, name)
+        if span is None:
+            sys.exit(f"no {name} in the current host's trace.rs")
+        body = current[span[0]:span[1]]
+        mine = function_span(old, name)
+        if mine is not None:
+            old = old[:mine[0]] + body + old[mine[1]:]
+        else:
+            at = function_span(old, HARNESS[0])
+            if at is None:
+                sys.exit(f"no {HARNESS[0]} in {path}")
+            old = old[:at[0]] + body + "\n" + old[at[0]:]
+    return old
 
 
 def build_before(rev, repo):
-    """Builds the CLI at `rev` in a temporary worktree, with the current `prepare_rays` (the
-    harness that times construction) spliced in, so both builds time it alike; returns the
-    binary's path."""
+    """Builds the CLI at `rev` in a temporary worktree, with the current harness that times
+    construction spliced in ([`HARNESS`]), so both builds time it alike; returns the binary's
+    path."""
     work = tempfile.mkdtemp(prefix="raykernel-before-")
     tree = os.path.join(work, "tree")
     target = os.path.join(work, "target")
@@ -64,10 +88,8 @@ def build_before(rev, repo):
             current = f.read()
         with open(old_path) as f:
             old = f.read()
-        a, b = prepare_rays_fn(current, current_path)
-        c, d = prepare_rays_fn(old, old_path)
         with open(old_path, "w") as f:
-            f.write(old[:c] + current[a:b] + old[d:])
+            f.write(splice_harness(current, old, old_path))
         subprocess.run(["cargo", "build", "--release", "-q", "-p", "raykernel-host"],
                        cwd=tree, env={**os.environ, "CARGO_TARGET_DIR": target}, check=True)
     finally:
