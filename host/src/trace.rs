@@ -436,7 +436,8 @@ fn trace_rays<S: Scalar, A: Accel<S>>(
 
 /// Closest hit of every `stride`-th record: one kernel ray, set from each record's raw origin,
 /// direction and interval ([`Ray::set_from_f32`], in place) inside the timed loop, then
-/// traced: what a caller pays per query. A record the kernel rejects is a miss. Returns the hits and the loop's wall time, ms.
+/// traced: what a caller pays per query. A record the kernel rejects is a miss. Returns the
+/// hits and the loop's wall time, ms.
 ///
 /// # Panics
 /// If `stride` is 0.

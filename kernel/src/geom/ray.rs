@@ -1,6 +1,17 @@
 use crate::scalar::RayError;
 use crate::scalar::Scalar;
 
+/// [`RayError::InvalidInterval`] unless `0 <= t_min <= t_max` with `t_min` finite (`f32`
+/// bounds, before conversion to the mode).
+#[inline(always)]
+fn check_f32_interval(t_min: f32, t_max: f32) -> Result<(), RayError> {
+    if t_min >= 0.0 && t_min.is_finite() && t_max >= t_min {
+        Ok(())
+    } else {
+        Err(RayError::InvalidInterval)
+    }
+}
+
 /// A half-line `origin + t·dir` for `t` in `[t_min, t_max]`, with its precomputed test data.
 ///
 /// The direction is normalised by the constructors, so `t` is a distance in both modes.
@@ -48,9 +59,7 @@ impl<S: Scalar> Ray<S> {
         t_min: f32,
         t_max: f32,
     ) -> Result<Self, RayError> {
-        if !(t_min >= 0.0 && t_min.is_finite() && t_max >= t_min) {
-            return Err(RayError::InvalidInterval);
-        }
+        check_f32_interval(t_min, t_max)?;
         let data = S::ray_data_from_f32(origin, dir)?;
         Ok(Self {
             data,
@@ -74,9 +83,7 @@ impl<S: Scalar> Ray<S> {
         t_min: f32,
         t_max: f32,
     ) -> Result<(), RayError> {
-        if !(t_min >= 0.0 && t_min.is_finite() && t_max >= t_min) {
-            return Err(RayError::InvalidInterval);
-        }
+        check_f32_interval(t_min, t_max)?;
         S::set_ray_data_from_f32(&mut self.data, origin, dir)?;
         self.t_min = S::from_f32_saturating(t_min);
         self.t_max = S::from_f32_saturating(t_max);
