@@ -18,8 +18,8 @@
 //!   `f64` quotient (over `2^9` times both errors) holds no midpoint: then both give the `f32`
 //!   nearest to `t`. (Tested multiplied through by `|det|`, which saves two divisions; the
 //!   few roundings of that test are far inside the factor `2^9`.) Also refused: `det` within
-//!   `2^-20·S` of zero (so neither solve divides by a cancelled value), a zero or non-finite
-//!   result (signs of zeros, overflow).
+//!   `2^-20·S` of zero (so neither solve divides by a cancelled value), a zero, subnormal or
+//!   non-finite result (signs of zeros, the uneven gaps below the normal range, overflow).
 
 const CONDITION: f64 = 1.0 / 1_048_576.0; // 2^-20
 const RELATIVE: f64 = 1.0 / 4_294_967_296.0; // 2^-32
@@ -42,19 +42,75 @@ pub(super) fn certified_t(a: &[f32; 3], b: &[f32; 3], c: &[f32; 3]) -> Option<f3
     }
     let t = num / det;
     let t32 = t as f32;
-    if t32 == 0.0 || !t32.is_finite() {
-        return None;
-    }
-    // The midpoints towards both neighbours (`bits - 1` is nearer zero, `bits + 1` farther;
-    // an infinite neighbour only makes that half-gap infinite).
-    let bits = t32.to_bits();
+    let half_gap = half_gap(t32)?;
     let at = f64::from(t32);
-    let nearer = (at - f64::from(f32::from_bits(bits - 1))).abs();
-    let farther = (f64::from(f32::from_bits(bits + 1)) - at).abs();
-    let half_gap = nearer.min(farther) * 0.5;
     // `|t - at| + |t|·RELATIVE·K < half_gap`, multiplied through by `|det|` (using
     // `|t|·|det| = |num|`): one division per candidate instead of three.
     let d = det.abs();
     let bound = RELATIVE * (num.abs() + z + t.abs() * s);
     ((t - at).abs() * d + bound < half_gap * d).then_some(t32)
+}
+
+/// The distance from a normal `x` to the nearest midpoint between it and a neighbour: half the
+/// smaller gap, `2^(E-24)` for `|x|` in the binade `2^E`, or `2^(E-25)` at a power of two
+/// (whose neighbour towards zero is twice as near; at the smallest normal this is half the true
+/// distance, which only refuses more). `None` for a zero, subnormal or non-finite `x`.
+#[inline(always)]
+fn half_gap(x: f32) -> Option<f64> {
+    let bits = x.to_bits() & 0x7fff_ffff;
+    if !(0x0080_0000..0x7f80_0000).contains(&bits) {
+        return None;
+    }
+    let biased = u64::from(bits >> 23);
+    let below = if bits & 0x007f_ffff == 0 { 25 } else { 24 };
+    Some(f64::from_bits((biased + 1023 - 127 - below) << 52))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::half_gap;
+
+    /// The half gap from the neighbours' bits, as the definition reads.
+    fn from_neighbours(x: f32) -> f64 {
+        let (bits, at) = (x.to_bits(), f64::from(x));
+        let nearer = (at - f64::from(f32::from_bits(bits - 1))).abs();
+        let farther = (f64::from(f32::from_bits(bits + 1)) - at).abs();
+        nearer.min(farther) * 0.5
+    }
+
+    #[test]
+    fn half_gap_is_half_the_distance_to_the_nearer_neighbour() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let random = (0..100_000).flat_map(|_| {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1);
+            let x = f32::from_bits((state >> 32) as u32);
+            [x, f32::from_bits(x.to_bits() & 0xff80_0000)] // and a power of two
+        });
+        let fixed = [
+            1.0f32,
+            1.5,
+            3.0e38,
+            f32::MAX,
+            1.0e-30,
+            f32::MIN_POSITIVE,
+            -0.75,
+        ];
+        let mut tested = 0;
+        for x in fixed.into_iter().chain(random) {
+            let Some(got) = half_gap(x) else {
+                assert!(x == 0.0 || !x.is_normal(), "{x:e}");
+                continue;
+            };
+            let want = if x.abs() == f32::MIN_POSITIVE {
+                from_neighbours(x) * 0.5
+            } else {
+                from_neighbours(x)
+            };
+            assert_eq!(got, want, "{x:e}");
+            tested += 1;
+        }
+        assert!(tested > 150_000, "{tested}");
+    }
 }
