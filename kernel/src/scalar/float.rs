@@ -42,9 +42,10 @@ const WIDEN: f32 = 1.0 + 2.0 * MARGIN;
 /// Per-ray data for `f32` mode. Built only by [`crate::Ray`]'s constructors.
 #[derive(Clone, Copy, Debug)]
 pub struct FloatRay {
-    origin: [f32; 3],
-    /// Unit direction.
-    dir: [f32; 3],
+    /// Origin, z repeated in lane 3 (stored and read as one vector, see [`lanes`]).
+    origin: [f32; 4],
+    /// Unit direction, z repeated in lane 3.
+    dir: [f32; 4],
     /// `1 / dir`, `±inf` for `±0` components (sign preserved, never NaN); z repeated in lane 3.
     inv: [f32; 4],
     /// Origin as seen from the boxes' `lo` planes: moved up by the margin, which enlarges
@@ -83,6 +84,12 @@ impl Axis {
 #[inline(always)]
 fn axis(v: &[f32; 3], k: Axis) -> f32 {
     v[k as usize]
+}
+
+/// `[x, y, z, z]`: a 3-vector as the four lanes of an [`F4`].
+#[inline(always)]
+fn lanes([x, y, z]: [f32; 3]) -> [f32; 4] {
+    [x, y, z, z]
 }
 
 fn abs(x: f32) -> f32 {
@@ -129,17 +136,18 @@ fn check_coord(x: f32) -> Result<(), PointError> {
     }
 }
 
-/// Unit vector along `d` in `f32`: `d` scaled by the power of two that brings its largest
-/// component into `[1, 2)` (exact, except for components below 2^-149 of that one, whose
-/// unit values are subnormal anyway), then divided by the correctly rounded length. Neither
-/// overflow nor underflow can occur in the squares (their sum lies in `[1, 12)`).
+/// Unit vector along `d` in `f32`, z repeated in lane 3: `d` scaled by the power of two that
+/// brings its largest component into `[1, 2)` (exact, except for components below 2^-149 of
+/// that one, whose unit values are subnormal anyway), then divided by the correctly rounded
+/// length. Neither overflow nor underflow can occur in the squares (their sum lies in
+/// `[1, 12)`).
 ///
 /// Error: the squared length carries at most three roundings (`γ₃ ≤ 3·2^-24`), its square
 /// root halves that and adds one, each quotient one more, so every component is within
 /// `3.5·2^-24` relative of the exact unit vector's, `| |dir| - 1 | < 2^-22`, and
 /// `|dir_i| <= 1 + 2^-23`.
 #[cfg_attr(not(target_os = "none"), inline(always))]
-fn unit_dir(d: [f32; 3]) -> Result<[f32; 3], RayError> {
+fn unit_dir(d: [f32; 3]) -> Result<[f32; 4], RayError> {
     if !(d[0].is_finite() && d[1].is_finite() && d[2].is_finite()) {
         return Err(RayError::NonFiniteDirection);
     }
@@ -150,11 +158,8 @@ fn unit_dir(d: [f32; 3]) -> Result<[f32; 3], RayError> {
     let k = recip_binade(m);
     let s = [d[0] * k, d[1] * k, d[2] * k];
     let len = sqrtf(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-    // Three quotients in one vector division (each lane the same IEEE quotient).
-    let q = F4::new([s[0], s[1], s[2], s[2]])
-        .div(F4::splat(len))
-        .to_array();
-    Ok([q[0], q[1], q[2]])
+    // Three quotients in one vector division (each lane the same IEEE quotient), z repeated.
+    Ok(F4::new(lanes(s)).div(F4::splat(len)).to_array())
 }
 
 /// Unit vector along `d`, computed in `f64` after scaling by the largest component so that
@@ -204,9 +209,7 @@ impl FloatRay {
     ) -> Result<Self, RayError> {
         let dir = unit_dir(dir)?;
         // Four quotients in one vector division (each lane the same IEEE quotient).
-        let inv = F4::splat(1.0)
-            .div(F4::new([dir[0], dir[1], dir[2], dir[2]]))
-            .to_array();
+        let inv = F4::splat(1.0).div(F4::new(dir)).to_array();
 
         // Watertight test: kz is the dominant axis; swapping kx/ky keeps the winding.
         let a = [abs(dir[0]), abs(dir[1]), abs(dir[2])];
@@ -218,14 +221,14 @@ impl FloatRay {
             Axis::Z
         };
         let (mut kx, mut ky) = kz.following();
-        if axis(&dir, kz) < 0.0 {
+        if dir[kz as usize] < 0.0 {
             core::mem::swap(&mut kx, &mut ky);
         }
         let sz = inv[kz as usize]; // 1 / dir[kz], the same quotient
-        let shear = [axis(&dir, kx) * sz, axis(&dir, ky) * sz, sz];
+        let shear = [dir[kx as usize] * sz, dir[ky as usize] * sz, sz];
         let k = [kx, ky, kz];
         Ok(Self {
-            origin,
+            origin: lanes(origin),
             dir,
             inv,
             o_lo,
@@ -284,7 +287,7 @@ impl FloatRay {
         let (o_lo, o_hi) = Self::shifted_origins(origin);
         let [kx, ky, kz] = self.k;
         Ok(Self {
-            origin,
+            origin: lanes(origin),
             o_lo,
             o_hi,
             o_perm: [axis(&origin, kx), axis(&origin, ky), axis(&origin, kz)],
@@ -330,8 +333,30 @@ impl FloatRay {
     /// nearly edge-on sliver can carry a `t` far off (det is tiny); rejecting it keeps every
     /// reported hit inside the boxes traversal tests, so no accelerator can cull a hit that
     /// brute force would report.
+    ///
+    /// Hosted targets test the three axes at once in [`F4`] lanes x, y, z, z, each lane with
+    /// the operations of [`FloatRay::point_near_box_per_axis`] (`max` of magnitudes, never NaN,
+    /// is exact in any order); bare-metal targets run that per-axis loop (flash).
     #[inline(always)]
     fn point_near_box(&self, t: f32, v: &[[f32; 3]; 3]) -> bool {
+        if cfg!(target_os = "none") {
+            return self.point_near_box_per_axis(t, v);
+        }
+        let vertex = |p: &[f32; 3]| F4::new(lanes(*p));
+        let (a, b, c) = (vertex(&v[0]), vertex(&v[1]), vertex(&v[2]));
+        let o = F4::new(self.origin);
+        let m = a.abs().max(b.abs()).max(c.abs().max(o.abs()));
+        let m = m.max(m.high_half());
+        let e = F4::splat(m.lane0().max_of(m.lane1()) * (MARGIN * 0.5));
+        let p = o.add(F4::splat(t).mul(F4::new(self.dir)));
+        let lo = a.min(b).min(c).sub(e);
+        let hi = a.max(b).max(c).add(e);
+        lo.le_mask(p) & p.le_mask(hi) == 0b1111
+    }
+
+    /// [`FloatRay::point_near_box`], one axis after the other.
+    #[inline(always)]
+    fn point_near_box_per_axis(&self, t: f32, v: &[[f32; 3]; 3]) -> bool {
         let m = max_abs(&self.origin).max_of(max_abs(v.as_flattened()));
         let e = m * (MARGIN * 0.5);
         let [a, b, c] = v;
@@ -435,32 +460,57 @@ fn exact_edge(p: &[f32; 3], q: &[f32; 3]) -> f32 {
     exact_cross(&[*p, *q, [0.0; 3]], Axis::X, Axis::Y)
 }
 
+/// The components of `(b - a) × (c - a)` as `(i, j)` axis pairs: x, y, z.
+const COMPONENTS: [(Axis, Axis); 3] = [(Axis::Y, Axis::Z), (Axis::Z, Axis::X), (Axis::X, Axis::Y)];
+
 /// True if the triangle has exactly zero area: `(b - a) × (c - a) = 0`. Each component is
 /// first evaluated in `f32` ([`surely_non_zero`]); only if none is surely non-zero are they
 /// decided exactly ([`exact_cross`]).
 #[inline(always)]
 fn zero_area(v: &[[f32; 3]; 3]) -> bool {
-    const COMPONENTS: [(Axis, Axis); 3] =
-        [(Axis::Y, Axis::Z), (Axis::Z, Axis::X), (Axis::X, Axis::Y)];
-    !COMPONENTS.iter().any(|&(i, j)| surely_non_zero(v, i, j))
+    !some_component_surely_non_zero(v)
         && COMPONENTS.iter().all(|&(i, j)| exact_cross(v, i, j) == 0.0)
 }
+
+/// True if [`surely_non_zero`] holds for some component. Hosted targets test the three
+/// components at once, in lanes 0, 1, 2 (x, y, z) of [`F4`], each lane with the operations
+/// of the scalar test; bare-metal targets call the scalar test per component (flash).
+#[inline(always)]
+fn some_component_surely_non_zero(v: &[[f32; 3]; 3]) -> bool {
+    if cfg!(target_os = "none") {
+        return COMPONENTS.iter().any(|&(i, j)| surely_non_zero(v, i, j));
+    }
+    let vertex = |p: &[f32; 3]| F4::new(lanes(*p));
+    let a = vertex(&v[0]);
+    let (e1, e2) = (vertex(&v[1]).sub(a), vertex(&v[2]).sub(a));
+    // Lane k: the products of component k, `(y, z)`, `(z, x)`, `(x, y)`.
+    let (p, q) = (e1.yzx().mul(e2.zxy()), e1.zxy().mul(e2.yzx()));
+    let bound = p
+        .abs()
+        .add(q.abs())
+        .mul(F4::splat(SURE_REL))
+        .add(F4::splat(SURE_ABS));
+    // Nothing here is NaN (coordinates are finite and at most 2^40), so "not <=" is ">".
+    p.sub(q).abs().le_mask(bound) & 0b111 != 0b111
+}
+
+/// [`surely_non_zero`]'s relative error bound (2^-21).
+const SURE_REL: f32 = 1.0 / 2_097_152.0;
+/// [`surely_non_zero`]'s absolute error bound, for underflow (2^-120).
+const SURE_ABS: f32 = 7.523_164e-37;
 
 /// True if component `(i, j)` of `(b - a) × (c - a)` evaluated in `f32` exceeds its rounding
 /// error bound (differences, products and their difference: under `4·2^-24` of the products'
 /// magnitudes, bounded here by `2^-21` of them plus `2^-120` for underflow), so is surely
-/// non-zero. Inlined on hosted targets (speed; the three inlined calls share their edge
-/// differences); bare-metal targets keep one copy, which takes the four differences it needs
-/// on each call (flash: passing the edges in costs more code than the subtractions).
+/// non-zero. Bare-metal targets keep one copy, which takes the four differences it needs on
+/// each call (flash: passing the edges in costs more code than the subtractions).
 #[cfg_attr(not(target_os = "none"), inline(always))]
 #[cfg_attr(target_os = "none", inline(never))]
 fn surely_non_zero(v: &[[f32; 3]; 3], i: Axis, j: Axis) -> bool {
-    const REL: f32 = 1.0 / 2_097_152.0; // 2^-21
-    const ABS: f32 = 7.523_164e-37; // 2^-120
     let [a, b, c] = v;
     let edge = |p: &[f32; 3], k: Axis| axis(p, k) - axis(a, k);
     let (p, q) = (edge(b, i) * edge(c, j), edge(b, j) * edge(c, i));
-    abs(p - q) > (abs(p) + abs(q)) * REL + ABS
+    abs(p - q) > (abs(p) + abs(q)) * SURE_REL + SURE_ABS
 }
 
 /// Component `(i, j)` of `a × b + b × c + c × a`, which is that of `(b - a) × (c - a)`, with its
@@ -537,10 +587,12 @@ impl Scalar for f32 {
         }
     }
     fn ray_origin(ray: &FloatRay) -> [f32; 3] {
-        ray.origin
+        let [x, y, z, _] = ray.origin;
+        [x, y, z]
     }
     fn ray_dir(ray: &FloatRay) -> [f32; 3] {
-        ray.dir
+        let [x, y, z, _] = ray.dir;
+        [x, y, z]
     }
 }
 
@@ -575,7 +627,7 @@ impl Numerics for f32 {
     }
     #[cfg_attr(not(target_os = "none"), inline(always))]
     fn ray_redirected_f32(ray: &FloatRay, dir: [f32; 3]) -> Result<FloatRay, RayError> {
-        FloatRay::along(ray.origin, ray.o_lo, ray.o_hi, dir)
+        FloatRay::along(Self::ray_origin(ray), ray.o_lo, ray.o_hi, dir)
     }
 
     fn pad_bounds(lo: [f32; 3], hi: [f32; 3]) -> ([f32; 3], [f32; 3]) {
@@ -956,5 +1008,83 @@ mod tests {
         assert_eq!(r.inv[0], f32::INFINITY);
         assert_eq!(r.inv[1], f32::NEG_INFINITY);
         assert!(!r.inv.iter().any(|x| x.is_nan()));
+    }
+
+    /// Triangles for the checks of a hit: [`candidates`], the same with a coordinate axis
+    /// flattened (faces of axis-aligned boxes, whose normals have zero components), and
+    /// degenerate ones (collinear, coincident vertices, a point).
+    fn hit_checks_triangles() -> impl Iterator<Item = [[f32; 3]; 3]> {
+        candidates(3000).flat_map(|v| {
+            let flat = |k: usize| {
+                v.map(|mut p| {
+                    p[k] = v[0][k];
+                    p
+                })
+            };
+            let [a, b, _] = v;
+            let mid = core::array::from_fn(|k| a[k] + 0.5 * (b[k] - a[k]));
+            [
+                v,
+                flat(0),
+                flat(1),
+                flat(2),
+                [a, b, mid],
+                [a, a, b],
+                [a, a, a],
+            ]
+        })
+    }
+
+    #[test]
+    fn surely_non_zero_in_lanes_is_the_scalar_test_per_component() {
+        let (mut tested, mut sure) = (0, 0);
+        for v in hit_checks_triangles() {
+            let scalar = COMPONENTS.iter().any(|&(i, j)| surely_non_zero(&v, i, j));
+            assert_eq!(some_component_surely_non_zero(&v), scalar, "{v:?}");
+            tested += 1;
+            sure += usize::from(scalar);
+        }
+        assert!(
+            sure > tested / 2 && sure < tested,
+            "{sure} of {tested} surely non-zero"
+        );
+    }
+
+    #[test]
+    fn point_near_box_in_lanes_is_the_per_axis_loop() {
+        let mut state = 0x5eed_0000_0000_0011u64;
+        let (mut inside, mut outside) = (0, 0);
+        for (n, v) in hit_checks_triangles().enumerate() {
+            let mut unit = || (next(&mut state) >> 40) as f32 / 16_777_216.0 * 2.0 - 1.0;
+            // Origins small and large against the triangle, so either can set the margin.
+            let origin = [unit(), unit(), unit()].map(|x| x * libm::exp2f((n % 41) as f32 - 10.0));
+            let Ok(r) = FloatRay::new(origin, [unit(), unit(), 1.0]) else {
+                continue;
+            };
+            let e = max_abs(&origin).max_of(max_abs(v.as_flattened())) * (MARGIN * 0.5);
+            // Distances around the one where the ray meets the first vertex's z plane.
+            let t = libm::fabsf(v[0][2] - origin[2]) * (1.0 + 0.01 * unit());
+            // And rays aimed at points half a margin and one and a half outside the box's
+            // low x face (the rounding of `origin + t·dir` is far below the margin).
+            let aimed = [0.5f32, 1.5].map(|k| {
+                let lo_x = v[0][0].min_of(v[1][0]).min_of(v[2][0]);
+                let target = [lo_x - k * e, v[0][1], v[0][2]];
+                let d: [f32; 3] = core::array::from_fn(|i| target[i] - origin[i]);
+                let len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                (FloatRay::new(origin, d), len)
+            });
+            let cases = [(Ok(r), t), aimed[0], aimed[1]];
+            for (r, t) in cases {
+                let Ok(r) = r else { continue };
+                let want = r.point_near_box_per_axis(t, &v);
+                assert_eq!(r.point_near_box(t, &v), want, "{v:?} {origin:?} {t}");
+                inside += usize::from(want);
+                outside += usize::from(!want);
+            }
+        }
+        assert!(
+            inside > 100 && outside > 100,
+            "{inside} inside, {outside} outside"
+        );
     }
 }

@@ -18,7 +18,7 @@ mod sse {
     // every bit pattern is a valid `f32`; `clamped_trunc`'s copies an `__m128i` into a
     // `[u32; 4]`, where every bit pattern is valid too.
     use arch::{
-        __m128, __m128i, _mm_add_ps, _mm_cmple_ps, _mm_cvtepi32_ps, _mm_cvtss_f32,
+        __m128, __m128i, _mm_add_ps, _mm_andnot_ps, _mm_cmple_ps, _mm_cvtepi32_ps, _mm_cvtss_f32,
         _mm_cvttps_epi32, _mm_div_ps, _mm_loadu_si128, _mm_max_ps, _mm_min_ps, _mm_movehl_ps,
         _mm_movemask_ps, _mm_mul_ps, _mm_set1_epi32, _mm_set1_ps, _mm_setr_ps, _mm_shuffle_ps,
         _mm_sub_epi32, _mm_sub_ps, _mm_unpackhi_ps, _mm_unpacklo_ps,
@@ -71,6 +71,11 @@ mod sse {
                 _mm_cvtepi32_ps(_mm_sub_epi32(a, _mm_set1_epi32(b)))
             })
         }
+        /// Per lane `|a|`: the sign bit cleared.
+        #[inline(always)]
+        pub(crate) fn abs(self) -> Self {
+            Self(unsafe { _mm_andnot_ps(_mm_set1_ps(-0.0), self.0) })
+        }
         /// Per lane `if a < b { a } else { b }` (the second operand when unordered).
         #[inline(always)]
         pub(crate) fn min(self, o: Self) -> Self {
@@ -95,6 +100,16 @@ mod sse {
         #[inline(always)]
         pub(crate) fn high_half(self) -> Self {
             Self(unsafe { _mm_movehl_ps(self.0, self.0) })
+        }
+        /// `[a1, a2, a0, a1]`.
+        #[inline(always)]
+        pub(crate) fn yzx(self) -> Self {
+            Self(unsafe { _mm_shuffle_ps::<0b01_00_10_01>(self.0, self.0) })
+        }
+        /// `[a2, a0, a1, a2]`.
+        #[inline(always)]
+        pub(crate) fn zxy(self) -> Self {
+            Self(unsafe { _mm_shuffle_ps::<0b10_01_00_10>(self.0, self.0) })
         }
         /// Per lane `(x as i32).clamp(0, top)` for a whole `top` in `0..2^31`: the lane clamped
         /// to `[0, top]` (NaN to 0), then truncated (a floor there; exact up to 2^24).
@@ -133,10 +148,11 @@ mod neon {
     // is part of the aarch64 baseline). Only `vld1q_u32` touches memory: it reads the four
     // `u32` of a local array, which is valid, aligned and initialised.
     use core::arch::aarch64::{
-        float32x4_t, uint32x4_t, vaddq_f32, vaddvq_u32, vandq_u32, vbslq_f32, vcgtq_f32, vcleq_f32,
-        vcltq_f32, vcltzq_s32, vcombine_f32, vcvtq_f32_s32, vcvtq_u32_f32, vdivq_f32, vdupq_n_f32,
-        vdupq_n_s32, vget_high_f32, vgetq_lane_f32, vld1q_f32, vld1q_s32, vld1q_u32, vmulq_f32,
-        vreinterpretq_s32_f32, vst1q_f32, vst1q_u32, vsubq_f32, vsubq_s32, vzip1q_f32, vzip2q_f32,
+        float32x4_t, uint32x4_t, vabsq_f32, vaddq_f32, vaddvq_u32, vandq_u32, vbslq_f32, vcgtq_f32,
+        vcleq_f32, vcltq_f32, vcltzq_s32, vcombine_f32, vcvtq_f32_s32, vcvtq_u32_f32, vdivq_f32,
+        vdupq_n_f32, vdupq_n_s32, vget_high_f32, vgetq_lane_f32, vld1q_f32, vld1q_s32, vld1q_u32,
+        vmulq_f32, vreinterpretq_s32_f32, vst1q_f32, vst1q_u32, vsubq_f32, vsubq_s32, vzip1q_f32,
+        vzip2q_f32,
     };
 
     /// Four lanes in a NEON register.
@@ -188,6 +204,11 @@ mod neon {
             // SAFETY: see above; the load reads the four `i32` of `a`.
             Self(unsafe { vcvtq_f32_s32(vsubq_s32(vld1q_s32(a.as_ptr()), vdupq_n_s32(b))) })
         }
+        /// Per lane `|a|`: the sign bit cleared.
+        #[inline(always)]
+        pub(crate) fn abs(self) -> Self {
+            Self(unsafe { vabsq_f32(self.0) })
+        }
         /// Per lane `if a < b { a } else { b }` (the second operand when unordered).
         #[inline(always)]
         pub(crate) fn min(self, o: Self) -> Self {
@@ -212,6 +233,18 @@ mod neon {
         #[inline(always)]
         pub(crate) fn high_half(self) -> Self {
             Self(unsafe { vcombine_f32(vget_high_f32(self.0), vget_high_f32(self.0)) })
+        }
+        /// `[a1, a2, a0, a1]`.
+        #[inline(always)]
+        pub(crate) fn yzx(self) -> Self {
+            let a = self.to_array();
+            Self::new([a[1], a[2], a[0], a[1]])
+        }
+        /// `[a2, a0, a1, a2]`.
+        #[inline(always)]
+        pub(crate) fn zxy(self) -> Self {
+            let a = self.to_array();
+            Self::new([a[2], a[0], a[1], a[2]])
         }
         /// Per lane `(x as i32).clamp(0, top)` for a whole `top` in `0..2^31`: the lane clamped
         /// to `[0, top]` (NaN to 0), then truncated (a floor there; exact up to 2^24).
@@ -307,6 +340,10 @@ mod portable {
             Self(a.map(|x| x.wrapping_sub(b) as f32))
         }
         #[inline(always)]
+        pub(crate) fn abs(self) -> Self {
+            Self(self.0.map(libm::fabsf))
+        }
+        #[inline(always)]
         pub(crate) fn min(self, o: Self) -> Self {
             self.zip(o, |a, b| if a < b { a } else { b })
         }
@@ -328,6 +365,16 @@ mod portable {
         pub(crate) fn high_half(self) -> Self {
             let a = self.0;
             Self([a[2], a[3], a[2], a[3]])
+        }
+        #[inline(always)]
+        pub(crate) fn yzx(self) -> Self {
+            let a = self.0;
+            Self([a[1], a[2], a[0], a[1]])
+        }
+        #[inline(always)]
+        pub(crate) fn zxy(self) -> Self {
+            let a = self.0;
+            Self([a[2], a[0], a[1], a[2]])
         }
         #[inline(always)]
         pub(crate) fn clamped_trunc(self, top: f32) -> [u32; 4] {
@@ -422,11 +469,14 @@ mod tests {
                 sa.to_array().map(f32::to_bits),
                 "to_array {a:?}"
             );
+            same(pa.abs(), sa.abs(), "abs");
             same(pa.min(pb), sa.min(sb), "min");
             same(pa.max(pb), sa.max(sb), "max");
             same(pa.unpack_lo(pb), sa.unpack_lo(sb), "unpack_lo");
             same(pa.unpack_hi(pb), sa.unpack_hi(sb), "unpack_hi");
             same(pa.high_half(), sa.high_half(), "high_half");
+            same(pa.yzx(), sa.yzx(), "yzx");
+            same(pa.zxy(), sa.zxy(), "zxy");
             assert_eq!(pa.sign_mask(), sa.sign_mask(), "sign_mask {a:?}");
             same(P::splat(a[0]), S::splat(a[0]), "splat");
             assert_eq!(pa.le_mask(pb), sa.le_mask(sb), "le_mask {a:?} {b:?}");
@@ -479,6 +529,8 @@ mod tests {
         assert_eq!(lanes(a.unpack_lo(b)), [1.0f32, 5.0].map(f32::to_bits));
         assert_eq!(lanes(a.unpack_hi(b)), [3.0f32, 7.0].map(f32::to_bits));
         assert_eq!(lanes(a.high_half()), [3.0f32, 4.0].map(f32::to_bits));
+        assert_eq!(a.yzx().to_array(), [2.0, 3.0, 1.0, 2.0]);
+        assert_eq!(a.zxy().to_array(), [3.0, 1.0, 2.0, 3.0]);
         let c = F4::new([1.0, 9.0, f32::NAN, 4.0]);
         assert_eq!(a.le_mask(c), 0b1011);
         let sum = b.sub(F4::splat(1.0)).mul(F4::splat(2.0));
