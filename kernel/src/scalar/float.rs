@@ -207,7 +207,11 @@ impl FloatRay {
         o_hi: [f32; 4],
         dir: [f32; 3],
     ) -> Result<Self, RayError> {
-        let dir = unit_dir(dir)?;
+        // Stored whole before the lookups by axis below read single lanes back: split into
+        // lane stores, it stalled the ray's copy of it on store forwarding.
+        let mut dir_lanes = [0.0f32; 4];
+        F4::new(unit_dir(dir)?).store(&mut dir_lanes);
+        let dir = dir_lanes;
         // Four quotients in one vector division (each lane the same IEEE quotient).
         let inv = F4::splat(1.0).div(F4::new(dir)).to_array();
 

@@ -21,7 +21,7 @@ mod sse {
         __m128, __m128i, _mm_add_ps, _mm_andnot_ps, _mm_cmple_ps, _mm_cvtepi32_ps, _mm_cvtss_f32,
         _mm_cvttps_epi32, _mm_div_ps, _mm_loadu_si128, _mm_max_ps, _mm_min_ps, _mm_movehl_ps,
         _mm_movemask_ps, _mm_mul_ps, _mm_set1_epi32, _mm_set1_ps, _mm_setr_ps, _mm_shuffle_ps,
-        _mm_sub_epi32, _mm_sub_ps, _mm_unpackhi_ps, _mm_unpacklo_ps,
+        _mm_storeu_ps, _mm_sub_epi32, _mm_sub_ps, _mm_unpackhi_ps, _mm_unpacklo_ps,
     };
     #[cfg(target_arch = "x86")]
     use core::arch::x86 as arch;
@@ -61,6 +61,12 @@ mod sse {
         #[inline(always)]
         pub(crate) fn to_array(self) -> [f32; 4] {
             unsafe { core::mem::transmute::<__m128, [f32; 4]>(self.0) }
+        }
+        /// The lanes in order, written to `out` by one vector store.
+        #[inline(always)]
+        pub(crate) fn store(self, out: &mut [f32; 4]) {
+            // SAFETY: see above; the unaligned store writes the 16 bytes of `out`.
+            unsafe { _mm_storeu_ps(out.as_mut_ptr(), self.0) }
         }
         /// Per lane `a.wrapping_sub(b) as f32` (rounded to nearest).
         #[inline(always)]
@@ -195,8 +201,14 @@ mod neon {
         #[inline(always)]
         pub(crate) fn to_array(self) -> [f32; 4] {
             let mut out = [0.0f32; 4];
-            unsafe { vst1q_f32(out.as_mut_ptr(), self.0) };
+            self.store(&mut out);
             out
+        }
+        /// The lanes in order, written to `out` by one vector store.
+        #[inline(always)]
+        pub(crate) fn store(self, out: &mut [f32; 4]) {
+            // SAFETY: see above; the store writes the four `f32` of `out`.
+            unsafe { vst1q_f32(out.as_mut_ptr(), self.0) };
         }
         /// Per lane `a.wrapping_sub(b) as f32` (rounded to nearest).
         #[inline(always)]
@@ -331,6 +343,10 @@ mod portable {
         #[inline(always)]
         pub(crate) fn to_array(self) -> [f32; 4] {
             self.0
+        }
+        #[inline(always)]
+        pub(crate) fn store(self, out: &mut [f32; 4]) {
+            *out = self.0;
         }
         /// Only the vector backends' callers need it (`wide::slab4_fixed`); here for the
         /// comparison test.
@@ -469,6 +485,14 @@ mod tests {
                 sa.to_array().map(f32::to_bits),
                 "to_array {a:?}"
             );
+            let (mut stored_p, mut stored_s) = ([0.0f32; 4], [0.0f32; 4]);
+            pa.store(&mut stored_p);
+            sa.store(&mut stored_s);
+            assert_eq!(
+                stored_p.map(f32::to_bits),
+                stored_s.map(f32::to_bits),
+                "store {a:?}"
+            );
             same(pa.abs(), sa.abs(), "abs");
             same(pa.min(pb), sa.min(sb), "min");
             same(pa.max(pb), sa.max(sb), "max");
@@ -529,6 +553,9 @@ mod tests {
         assert_eq!(lanes(a.unpack_lo(b)), [1.0f32, 5.0].map(f32::to_bits));
         assert_eq!(lanes(a.unpack_hi(b)), [3.0f32, 7.0].map(f32::to_bits));
         assert_eq!(lanes(a.high_half()), [3.0f32, 4.0].map(f32::to_bits));
+        let mut stored = [0.0f32; 4];
+        a.store(&mut stored);
+        assert_eq!(stored, [1.0, 2.0, 3.0, 4.0]);
         assert_eq!(a.yzx().to_array(), [2.0, 3.0, 1.0, 2.0]);
         assert_eq!(a.zxy().to_array(), [3.0, 1.0, 2.0, 3.0]);
         let c = F4::new([1.0, 9.0, f32::NAN, 4.0]);
