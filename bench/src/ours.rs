@@ -58,12 +58,14 @@ pub fn configs() -> Vec<OurConfig> {
             vec![BuilderKind::default()]
         };
         for builder in builders {
+            // Primitives in leaf order wherever the structure takes it (the BVHs): one
+            // indirection fewer per primitive test, and no memory more (an in-place permutation).
             let accel = AccelConfig {
                 accel: accel.with_build_options(BuildOptions {
                     builder,
                     ..BuildOptions::default()
                 }),
-                leaf_order: false,
+                leaf_order: accel.permutes_into_leaf_order(),
             };
             for mode in Mode::ALL {
                 out.push(OurConfig {
