@@ -9,11 +9,11 @@ Runs `trace` of two builds of the CLI in alternation (before, after, before, ...
 scene, ray set and mode, with the 4-wide BVH from the SAH BVH, and writes a Markdown table.
 `--before-bin` defaults to a build of `--before-rev` (default f5262d3, the last commit whose
 `f32` rays were set up in `f64`), made in a temporary git worktree with the current
-`prepare_rays` (and the helpers it calls) spliced in; `--after-bin` defaults to `target/release/raykernel`. Both builds
-then time ray construction the same way (every traced record turned into a kernel ray and
-stored into a vector touched beforehand, timed apart from tracing), so the "construction"
-columns compare the kernels' constructors; "in the loop" is what the current
-per-ray loop pays over tracing pre-built rays (per ray minus pre-built), which the before build
+`prepare_rays` (and the helpers it calls) spliced in; `--after-bin` defaults to
+`target/release/raykernel`. Both builds then time ray construction the same way (every
+traced record turned into a kernel ray and stored into a vector touched beforehand, timed apart
+from tracing), so the "construction" columns compare the kernels' constructors; "in the loop"
+is what the current per-ray loop pays over tracing pre-built rays (per ray minus pre-built), which the before build
 cannot measure (it had no per-ray loop: a caller paid construction plus tracing).
 """
 import argparse

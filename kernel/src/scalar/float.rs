@@ -92,6 +92,12 @@ fn lanes([x, y, z]: [f32; 3]) -> [f32; 4] {
     [x, y, z, z]
 }
 
+/// [`lanes`] of `p` in an [`F4`].
+#[inline(always)]
+fn vector(p: &[f32; 3]) -> F4 {
+    F4::new(lanes(*p))
+}
+
 fn abs(x: f32) -> f32 {
     libm::fabsf(x)
 }
@@ -159,7 +165,7 @@ fn unit_dir(d: [f32; 3]) -> Result<[f32; 4], RayError> {
     let s = [d[0] * k, d[1] * k, d[2] * k];
     let len = sqrtf(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
     // Three quotients in one vector division (each lane the same IEEE quotient), z repeated.
-    Ok(F4::new(lanes(s)).div(F4::splat(len)).to_array())
+    Ok(vector(&s).div(F4::splat(len)).to_array())
 }
 
 /// Unit vector along `d`, computed in `f64` after scaling by the largest component so that
@@ -346,8 +352,7 @@ impl FloatRay {
         if cfg!(target_os = "none") {
             return self.point_near_box_per_axis(t, v);
         }
-        let vertex = |p: &[f32; 3]| F4::new(lanes(*p));
-        let (a, b, c) = (vertex(&v[0]), vertex(&v[1]), vertex(&v[2]));
+        let (a, b, c) = (vector(&v[0]), vector(&v[1]), vector(&v[2]));
         let o = F4::new(self.origin);
         let m = a.abs().max(b.abs()).max(c.abs().max(o.abs()));
         let m = m.max(m.high_half());
@@ -484,9 +489,8 @@ fn some_component_surely_non_zero(v: &[[f32; 3]; 3]) -> bool {
     if cfg!(target_os = "none") {
         return COMPONENTS.iter().any(|&(i, j)| surely_non_zero(v, i, j));
     }
-    let vertex = |p: &[f32; 3]| F4::new(lanes(*p));
-    let a = vertex(&v[0]);
-    let (e1, e2) = (vertex(&v[1]).sub(a), vertex(&v[2]).sub(a));
+    let a = vector(&v[0]);
+    let (e1, e2) = (vector(&v[1]).sub(a), vector(&v[2]).sub(a));
     // Lane k: the products of component k, `(y, z)`, `(z, x)`, `(x, y)`.
     let (p, q) = (e1.yzx().mul(e2.zxy()), e1.zxy().mul(e2.yzx()));
     let bound = p
