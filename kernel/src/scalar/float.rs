@@ -142,6 +142,28 @@ fn check_coord(x: f32) -> Result<(), PointError> {
     }
 }
 
+/// Unit vector along `d` in `f32`, z repeated in lane 3: [`normalized`]`(d)`, bit for bit, but
+/// found without a square root or a division when `d` is already a unit vector as [`normalized`]
+/// sees it (most unit vectors a caller rounds to `f32`).
+///
+/// That is when `q = (dx·dx + dy·dy) + dz·dz`, in `f32`, is 1 or its upper neighbour
+/// `1 + 2^-23`: then [`normalized`] returns `d` itself. It scales `d` by a power of two `k`,
+/// and the squared length of `k·d` it computes is `k²·q` (scaling by a power of two commutes
+/// with rounding; a square small enough to round differently once scaled lies far below half
+/// an ulp of a sum near 1 and vanishes in it either way), so the length is `k·sqrtf(q) = k`
+/// (the square root of `1 + 2^-23` lies just under the midpoint `1 + 2^-24` and rounds to 1),
+/// and each quotient `(k·d_i) / k` is `d_i`. Non-finite components make `q` non-finite and go
+/// to [`normalized`], which rejects them.
+#[cfg_attr(not(target_os = "none"), inline(always))]
+fn unit_dir(d: [f32; 3]) -> Result<[f32; 4], RayError> {
+    let q = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    // `q` is 1 (bits 0x3f80_0000) or the next float up: one unsigned comparison.
+    if q.to_bits().wrapping_sub(1.0f32.to_bits()) <= 1 {
+        return Ok(lanes(d));
+    }
+    normalized(d)
+}
+
 /// Unit vector along `d` in `f32`, z repeated in lane 3: `d` scaled by the power of two that
 /// brings its largest component into `[1, 2)` (exact, except for components below 2^-149 of
 /// that one, whose unit values are subnormal anyway), then divided by the correctly rounded
@@ -153,7 +175,7 @@ fn check_coord(x: f32) -> Result<(), PointError> {
 /// `3.5·2^-24` relative of the exact unit vector's, `| |dir| - 1 | < 2^-22`, and
 /// `|dir_i| <= 1 + 2^-23`.
 #[cfg_attr(not(target_os = "none"), inline(always))]
-fn unit_dir(d: [f32; 3]) -> Result<[f32; 4], RayError> {
+fn normalized(d: [f32; 3]) -> Result<[f32; 4], RayError> {
     if !(d[0].is_finite() && d[1].is_finite() && d[2].is_finite()) {
         return Err(RayError::NonFiniteDirection);
     }
@@ -843,6 +865,49 @@ mod tests {
     }
 
     use crate::scalar::xorshift as next;
+
+    /// `unit_dir` takes `d` as given exactly when `normalized` returns it bit for bit: checked on
+    /// unit vectors rounded from `f64` (with tiny and zero components, of every sign and order),
+    /// which take the shortcut most of the time, and on their neighbours one ulp away.
+    #[test]
+    fn unit_dir_shortcut_is_the_normalisation() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut unit = || (next(&mut state) >> 11) as f64 / 9_007_199_254_740_992.0 * 2.0 - 1.0;
+        let (mut shortcut, mut total) = (0usize, 0usize);
+        for i in 0..400_000 {
+            let mut v = [unit(), unit(), unit()];
+            match i % 8 {
+                0 => v[i % 3] *= 1e-30,
+                1 => v[(i / 8) % 3] = 0.0,
+                2 => (v[0], v[1]) = (v[0] * 1e-21, v[1] * 1e-25),
+                _ => {}
+            }
+            let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            if len == 0.0 {
+                continue;
+            }
+            let d = v.map(|x| (x / len) as f32);
+            let k = (i / 16) % 3;
+            let mut nudged = d;
+            nudged[k] = step(d[k], i % 2 == 0);
+            for d in [d, nudged] {
+                let (Ok(got), Ok(want)) = (unit_dir(d), normalized(d)) else {
+                    panic!("{d:?} rejected");
+                };
+                assert_eq!(got.map(f32::to_bits), want.map(f32::to_bits), "{d:?}");
+                total += 1;
+                let q = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                shortcut += usize::from(q == 1.0 || q == 1.0 + f32::EPSILON);
+            }
+        }
+        assert!(
+            shortcut > total / 3,
+            "shortcut taken {shortcut} of {total} times"
+        );
+        for bad in [[f32::NAN, 0.0, 1.0], [f32::INFINITY, 0.0, 0.0], [0.0; 3]] {
+            assert!(unit_dir(bad).is_err(), "{bad:?}");
+        }
+    }
 
     /// The next representable value above (`up`) or below `x`.
     fn step(x: f32, up: bool) -> f32 {
