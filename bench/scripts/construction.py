@@ -13,8 +13,9 @@ scene, ray set and mode, with the 4-wide BVH from the SAH BVH, and writes a Mark
 `target/release/raykernel`. Both builds then time ray construction the same way (every
 traced record turned into a kernel ray and stored into a vector touched beforehand, timed apart
 from tracing), so the "construction" columns compare the kernels' constructors; "in the loop"
-is what the current per-ray loop pays over tracing pre-built rays (per ray minus pre-built), which the before build
-cannot measure (it had no per-ray loop: a caller paid construction plus tracing).
+is what the current per-ray loop pays over tracing pre-built rays (per ray minus pre-built),
+which the before build cannot measure (it had no per-ray loop: a caller paid construction plus
+tracing).
 """
 import argparse
 import json

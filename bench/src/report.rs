@@ -467,8 +467,8 @@ fn headline_section(s: &mut String, r: &BenchResults) {
          their conversion time is added to their trace time. `pre-built` is raykernel tracing \
          rays constructed ahead (traversal alone). Ours is raykernel `f32`, the 4-wide BVH \
          collapsed from the SAH BVH with the triangles permuted into leaf order \
-         (`build_in_leaf_order`, in place), watertight; ratios are ours per ray ÷ peer: above 1 means \
-         ours is faster. `fixed ÷ f32` is the same structure in fixed point per ray, ray \
+         (`build_in_leaf_order`, in place), watertight; ratios are ours per ray ÷ peer: above \
+         1 means ours is faster. `fixed ÷ f32` is the same structure in fixed point per ray, ray \
          construction included, against `f32`.\n"
     );
     let mut head =
@@ -620,8 +620,8 @@ fn rounds_section(s: &mut String, r: &BenchResults) {
     let _ = writeln!(
         s,
         "### Interleaved rounds\n\n\
-         Each ray set traced {} times in alternation: raykernel `f32` (4-wide BVH, SAH, leaf order) per \
-         ray, Embree 3 HIGH, raykernel on pre-built rays, tinybvh 1.6's BVH2 on pre-built \
+         Each ray set traced {} times in alternation: raykernel `f32` (4-wide BVH, SAH, leaf \
+         order) per ray, Embree 3 HIGH, raykernel on pre-built rays, tinybvh 1.6's BVH2 on pre-built \
          rays; each structure built once. A slow spell of the machine then slows every \
          contender of a round, so the per-round ratio is the robust comparison: ours per ray ÷ \
          Embree (both pay their ray setup), ours pre-built ÷ tinybvh (neither does). `best` is \

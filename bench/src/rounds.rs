@@ -117,9 +117,10 @@ fn best(xs: &[f64]) -> f64 {
 /// The headline configuration: 4-wide BVH, default (SAH) build, primitives in leaf order.
 #[must_use]
 pub fn headline_config() -> AccelConfig {
+    let accel = AccelKind::Bvh4(raykernel::bvh::BuildOptions::default());
     AccelConfig {
-        accel: AccelKind::Bvh4(raykernel::bvh::BuildOptions::default()),
-        leaf_order: true,
+        accel,
+        leaf_order: accel.permutes_into_leaf_order(),
     }
 }
 

@@ -33,7 +33,7 @@ pub const F32_COORD_LIMIT: f32 = 1_099_511_627_776.0;
 /// The direction's length does not enter these bounds: the slab test (through `1 / dir`), the
 /// triangle test (through its shear) and the hit point check (`origin + t·dir`) all measure
 /// `t` along the same stored `f32` direction, so a hit and the boxes around it are compared in
-/// one parametrisation whatever `|dir|` is. The normalisation error (see [`unit_dir`]) only
+/// one parametrisation whatever `|dir|` is. The normalisation error (see [`normalized`]) only
 /// makes `t` a distance to within a relative 2^-22.
 const MARGIN: f32 = 1.0 / 524_288.0;
 /// The factor of `Numerics::widen`: exits up to `(1 + 2·MARGIN)·t` count as inside.
