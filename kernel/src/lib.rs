@@ -31,12 +31,15 @@
 //! ```
 #![no_std]
 // Exceptions, each confined and documented where it is: SSE and NEON intrinsics
-// (`scalar/lanes.rs`), the in-place view of checked baked bytes (`accel/baked/plain.rs`) and
-// the square-root instruction of Cortex-M cores with an FPU (`scalar/float/sqrt.rs`).
+// (`scalar/lanes.rs`), the in-place view of checked baked bytes (`accel/baked/plain.rs`), the
+// square-root instruction of Cortex-M cores with an FPU (`scalar/float/sqrt.rs`), and x86_64's
+// feature detection and the call of the traversal's AVX2 copy (`cpu.rs`,
+// `accel/bvh4/traverse.rs`).
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
 mod accel;
+pub mod cpu;
 mod geom;
 pub mod render;
 mod scalar;

@@ -56,13 +56,51 @@ fn sort_nearest_first<S: Scalar>(e: &mut [Entry<S>; 4], n: usize) {
 impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
     /// Walks the tree. With `ANY`, returns at the first hit in range; otherwise finds the
     /// closest under [`closer`]. Returns (t, prim id, index into `prims`) of the hit;
-    /// `prim id == u32::MAX` for none.
-    #[inline(never)]
+    /// `prim id == u32::MAX` for none. Runs the copy of [`Bvh4::walk`] that
+    /// [`crate::cpu`] selects.
+    #[inline(always)]
     fn traverse<const ANY: bool, C: Counters>(
         &self,
         ray: &Ray<S>,
         stats: &mut C,
     ) -> (S, u32, usize) {
+        #[cfg(all(target_arch = "x86_64", not(target_feature = "avx2")))]
+        if crate::cpu::avx2() {
+            #[allow(unsafe_code)]
+            // SAFETY: `cpu::avx2` is true only on a CPU with every feature `walk_avx2` enables.
+            return unsafe { self.walk_avx2::<ANY, C>(ray, stats) };
+        }
+        self.walk_baseline::<ANY, C>(ray, stats)
+    }
+
+    /// [`Bvh4::walk`] as compiled for the target.
+    #[inline(never)]
+    fn walk_baseline<const ANY: bool, C: Counters>(
+        &self,
+        ray: &Ray<S>,
+        stats: &mut C,
+    ) -> (S, u32, usize) {
+        self.walk::<ANY, C>(ray, stats)
+    }
+
+    /// [`Bvh4::walk`] compiled for AVX2 (see [`crate::cpu`]).
+    ///
+    /// # Safety
+    /// The CPU must have every feature enabled here (`cpu::avx2` checks).
+    #[cfg(all(target_arch = "x86_64", not(target_feature = "avx2")))]
+    #[allow(unsafe_code)]
+    #[target_feature(enable = "avx,avx2,bmi1,bmi2,lzcnt,popcnt")]
+    unsafe fn walk_avx2<const ANY: bool, C: Counters>(
+        &self,
+        ray: &Ray<S>,
+        stats: &mut C,
+    ) -> (S, u32, usize) {
+        self.walk::<ANY, C>(ray, stats)
+    }
+
+    /// The traversal itself, inlined into each compiled copy.
+    #[inline(always)]
+    fn walk<const ANY: bool, C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> (S, u32, usize) {
         let rd = ray.data();
         let t_min = ray.t_min();
         // (t, prim id, index into `prims`) of the best hit so far.
