@@ -98,6 +98,41 @@ fn to_round(v: f64) -> f64 {
     }
 }
 
+/// A unit vector in Q2.30 raw units: each component `u` as `to_round(u · 2^30)`.
+#[inline(always)]
+fn q30(unit: [f64; 3]) -> [i64; 3] {
+    unit.map(|u| to_round(u * DIR_ONE) as i64)
+}
+
+/// How close to a tie (an integer plus one half, in raw units) the direct normalisation may
+/// come before [`q30_from_f32`] defers to the scaled one: `2^-16`.
+const TIE_BAND: f64 = 1.0 / 65_536.0;
+
+/// `q30(unit_dir_from_f32(d)?)`, the direction of a ray given in `f32`, bit for bit; about one
+/// direction in 10^4 pays for both normalisations.
+///
+/// The direct normalisation (`float::unit_dir_direct_f32`: one square root and one division,
+/// against the scaled one's two divisions besides) is rounded instead, and kept when every
+/// component lies more than [`TIE_BAND`] from a tie. The two are within relative errors of
+/// `3·2^-53` and `6.5·2^-53` of the exact unit vector (their docs), so scaled by `2^30` each
+/// component differs by at most `9.5·2^-23 < 2^-19` raw units between them: both lie strictly
+/// between the same two ties, where `to_round` returns the same integer (the nearest; see its
+/// doc). Zero and non-finite directions take the scaled path, which returns their errors.
+#[cfg_attr(not(target_os = "none"), inline(always))]
+#[cfg_attr(target_os = "none", inline)]
+fn q30_from_f32(d: [f32; 3]) -> Result<[i64; 3], RayError> {
+    if let Some(unit) = super::float::unit_dir_direct_f32(d) {
+        let v = unit.map(|u| u * DIR_ONE);
+        let k = v.map(|x| to_round(x) as i64);
+        // `v - k` is exact: at most one half apart, and `k` is zero or within a factor two.
+        let clear = |i: usize| libm::fabs(v[i] - k[i] as f64) < 0.5 - TIE_BAND;
+        if clear(0) & clear(1) & clear(2) {
+            return Ok(k);
+        }
+    }
+    Ok(q30(super::float::unit_dir_from_f32(d)?))
+}
+
 fn saturate(x: i64) -> I16F16 {
     I16F16(if x > i32::MAX as i64 {
         i32::MAX
@@ -233,7 +268,7 @@ fn check_raw(x: i32) -> Result<(), PointError> {
 impl FixedRay {
     #[cfg_attr(not(target_os = "none"), inline(always))]
     #[cfg_attr(target_os = "none", inline)]
-    fn new(origin: [I16F16; 3], unit: [f64; 3]) -> Result<Self, RayError> {
+    fn new(origin: [I16F16; 3], dir: [i64; 3]) -> Result<Self, RayError> {
         for x in origin {
             check_raw(x.0).map_err(RayError::Origin)?;
         }
@@ -251,15 +286,15 @@ impl FixedRay {
             ))]
             inv_lanes: [0.0; 3],
         };
-        r.set_dir(unit);
+        r.set_dir(dir);
         Ok(r)
     }
 
-    /// Sets the direction (Q2.30, rounded from `unit`) and its reciprocals.
+    /// Sets the direction (Q2.30, from [`q30`] or [`q30_from_f32`]) and its reciprocals.
     #[cfg_attr(not(target_os = "none"), inline(always))]
     #[cfg_attr(target_os = "none", inline)]
-    fn set_dir(&mut self, unit: [f64; 3]) {
-        self.dir = unit.map(|u| to_round(u * DIR_ONE) as i64);
+    fn set_dir(&mut self, dir: [i64; 3]) {
+        self.dir = dir;
         self.recip = self
             .dir
             .map(|d| if d == 0 { i64::MAX } else { (1i64 << 62) / d });
@@ -389,7 +424,7 @@ impl Numerics for I16F16 {
     fn ray_data(origin: [Self; 3], dir: [Self; 3]) -> Result<FixedRay, RayError> {
         Self::check_point(origin).map_err(RayError::Origin)?;
         let unit = super::float::unit_dir_f64([dir[0].0 as f64, dir[1].0 as f64, dir[2].0 as f64])?;
-        FixedRay::new(origin, unit)
+        FixedRay::new(origin, q30(unit))
     }
     #[cfg_attr(not(target_os = "none"), inline(always))]
     #[cfg_attr(target_os = "none", inline)]
@@ -398,7 +433,7 @@ impl Numerics for I16F16 {
         for i in 0..3 {
             o[i] = Self::coord_from_f32(origin[i]).map_err(RayError::Origin)?;
         }
-        FixedRay::new(o, super::float::unit_dir_from_f32(dir)?)
+        FixedRay::new(o, q30_from_f32(dir)?)
     }
     fn ray_moved(ray: &FixedRay, origin: [Self; 3]) -> Result<FixedRay, RayError> {
         ray.moved(origin)
@@ -406,7 +441,7 @@ impl Numerics for I16F16 {
     #[inline]
     fn ray_redirected_f32(ray: &FixedRay, dir: [f32; 3]) -> Result<FixedRay, RayError> {
         let mut r = *ray;
-        r.set_dir(super::float::unit_dir_from_f32(dir)?);
+        r.set_dir(q30_from_f32(dir)?);
         Ok(r)
     }
 
@@ -581,12 +616,106 @@ mod tests {
 
     #[test]
     fn unit_directions_use_thirty_fraction_bits() {
-        let r = FixedRay::new([I16F16::ZERO; 3], [0.6, 0.8, 0.0]).unwrap();
+        let r = FixedRay::new([I16F16::ZERO; 3], q30([0.6, 0.8, 0.0])).unwrap();
         assert_eq!(r.dir, [644_245_094, 858_993_459, 0]);
         assert_eq!(r.recip[2], i64::MAX);
     }
 
     use crate::scalar::xorshift as next;
+
+    /// `q30_from_f32` returns `q30(unit_dir_from_f32(d))`, bit for bit, and the same errors:
+    /// on unit vectors rounded from `f64` (as ray generators give them), on unnormalised ones
+    /// over the whole `f32` range (subnormal, huge, zero components), and on zero and
+    /// non-finite ones. The direct path must serve nearly all and the scaled fallback some.
+    #[test]
+    fn direct_q30_is_the_scaled_normalisation() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let (mut direct, mut total) = (0usize, 0usize);
+        for i in 0..3_000_000u32 {
+            let mut component = || {
+                let bits = next(&mut state);
+                let x = (bits >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+                match i % 4 {
+                    0 | 1 => x as f32,
+                    2 => (x * libm::exp2(((bits & 0xff) as f64) - 150.0)) as f32,
+                    _ if bits & 7 == 0 => 0.0,
+                    _ => f32::from_bits(bits as u32 & 0x807f_ffff), // subnormal or zero
+                }
+            };
+            let mut d = [component(), component(), component()];
+            if i % 4 == 0 {
+                // Unit vectors rounded from f64, the common case.
+                let w = d.map(f64::from);
+                let n = crate::scalar::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+                d = w.map(|x| (x / n) as f32);
+            }
+            let want = super::super::float::unit_dir_from_f32(d).map(q30);
+            assert_eq!(
+                q30_from_f32(d),
+                want,
+                "{d:?} bits {:x?}",
+                d.map(f32::to_bits)
+            );
+            if want.is_ok() {
+                total += 1;
+                direct += usize::from(super::super::float::unit_dir_direct_f32(d).is_some_and(
+                    |unit| {
+                        unit.iter().all(|u| {
+                            let v = u * DIR_ONE;
+                            libm::fabs(v - to_round(v) as i64 as f64) < 0.5 - TIE_BAND
+                        })
+                    },
+                ));
+            }
+        }
+        // Directions whose x lies within about 2^-30 raw units of a tie, the rounding's hard
+        // cases: `(x, y, z)` with `x/y` about 2^-20 puts x near 2^10 raw units; x is stepped
+        // until its fraction is just above one half, then z, which shrinks it by about
+        // `x·z²/2y²`, is chosen to bring it onto the tie, and its neighbours are tried.
+        let raw_x = |d: [f32; 3]| {
+            super::super::float::unit_dir_direct_f32(d).map_or(0.0, |u| u[0] * DIR_ONE)
+        };
+        let fraction = |v: f64| v - libm::floor(v);
+        let mut near = 0usize;
+        for _ in 0..2000 {
+            let y = (1_048_576.0 * (1.0 + (next(&mut state) >> 40) as f64 / (1u64 << 24) as f64))
+                as f32;
+            let mut x = 1.0 + (next(&mut state) >> 41) as f32 / (1u64 << 23) as f32;
+            while !(0.5..0.5 + 1.0 / 4096.0).contains(&fraction(raw_x([x, y, 0.0]))) && x < 4.0 {
+                x = f32::from_bits(x.to_bits() + 1);
+            }
+            let v = raw_x([x, y, 0.0]);
+            let z0 = (f64::from(y) * crate::scalar::sqrt(2.0 * (fraction(v) - 0.5) / v)) as f32;
+            for step in -40i32..40 {
+                let d = [x, y, f32::from_bits(z0.to_bits().wrapping_add_signed(step))];
+                if libm::fabs(fraction(raw_x(d)) - 0.5) < 1.0 / 1_048_576.0 {
+                    near += 1;
+                }
+                let want = super::super::float::unit_dir_from_f32(d).map(q30);
+                assert_eq!(
+                    q30_from_f32(d),
+                    want,
+                    "{d:?} bits {:x?}",
+                    d.map(f32::to_bits)
+                );
+            }
+        }
+        assert!(near > 10_000, "{near} directions within 2^-20 of a tie");
+        for d in [
+            [0.0; 3],
+            [f32::NAN, 1.0, 0.0],
+            [0.0, f32::INFINITY, 1.0],
+            [-0.0, 0.0, -0.0],
+        ] {
+            let want = super::super::float::unit_dir_from_f32(d).map(q30);
+            assert!(want.is_err());
+            assert_eq!(q30_from_f32(d), want, "{d:?}");
+        }
+        assert!(
+            direct > total - total / 1000 && direct < total,
+            "{direct} of {total}"
+        );
+    }
 
     #[test]
     fn rounding_matches_libm_round() {
@@ -697,7 +826,7 @@ mod tests {
             let Ok(unit) = crate::scalar::float::unit_dir_f64(d) else {
                 continue;
             };
-            let r = FixedRay::new(origin, unit).expect("origin in range");
+            let r = FixedRay::new(origin, q30(unit)).expect("origin in range");
             let (mut lo, mut hi) = ([[I16F16(0); 4]; 3], [[I16F16(0); 4]; 3]);
             let mut boxes = [([0i64; 3], [0i64; 3]); 4];
             for (b, (bl, bh)) in boxes.iter_mut().enumerate() {
