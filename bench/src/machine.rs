@@ -15,6 +15,9 @@ pub struct Machine {
     pub rustc: String,
     /// `release` or `debug` (debug figures are not meaningful).
     pub profile: &'static str,
+    /// The instruction set the kernel's 4-wide traversal runs in (`raykernel::cpu`):
+    /// `baseline` or `avx2`.
+    pub traversal: &'static str,
     /// 1-minute load average at the start (other processes competing for the cores).
     pub load_start: Option<f64>,
     /// 1-minute load average at the end.
@@ -61,6 +64,7 @@ impl Machine {
             } else {
                 "release"
             },
+            traversal: raykernel::cpu::traversal_simd().name(),
             load_start: load_average(),
             load_end: None,
             others_cores: None,
@@ -79,12 +83,12 @@ impl Machine {
             .and_then(|(a, b)| b.others_since(&a));
     }
 
-    /// One line: `machine: CPU, N cores; rustc ...; release profile`.
+    /// One line: `machine: CPU, N cores; rustc ...; release profile; traversal in avx2`.
     #[must_use]
     pub fn line(&self) -> String {
         format!(
-            "machine: {}, {} cores; {}; {} profile",
-            self.cpu, self.cores, self.rustc, self.profile
+            "machine: {}, {} cores; {}; {} profile; traversal in {}",
+            self.cpu, self.cores, self.rustc, self.profile, self.traversal
         )
     }
 }
