@@ -11,6 +11,7 @@
 
 /// An instruction set the traversal can run in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum Simd {
     /// What the target was compiled for (SSE2 on a plain `x86_64` build, NEON on `aarch64`,
     /// scalar code on the Cortex-M cores).
