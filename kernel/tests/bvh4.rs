@@ -10,7 +10,10 @@
 
 mod common;
 
-use common::{c, query, same_hit, with_bvh, with_bvh4, RaySpec, TestScalar, LEAF_SIZES};
+use common::{
+    c, query, same_hit, with_bvh, with_bvh4, with_bvh_in_leaf_order, RaySpec, TestScalar,
+    LEAF_SIZES,
+};
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
 use raykernel::Arena;
@@ -380,18 +383,17 @@ fn deep_tree_cases<S: TestScalar>() {
             });
             // Leaf order: the same answers through permuted primitives.
             let mut own = tris.clone();
-            let mut nodes = vec![Node::<S>::EMPTY; nodes_needed(tris.len())];
-            let mut ids = vec![0u32; tris.len()];
-            let bvh = Bvh::build_in_leaf_order(&mut own, &mut nodes, &mut ids, options).unwrap();
-            with_bvh4(&bvh, |wide| {
-                assert!(wide.is_leaf_order());
-                wide.validate().unwrap();
-                for (r, w) in rays.iter().zip(&want) {
-                    let got = query(wide, &r.ray::<S>()).unwrap();
-                    same_hit(&got, w).unwrap_or_else(|e| {
-                        panic!("{} leaf order {options:?}: {e}, ray {r}", S::NAME)
-                    });
-                }
+            with_bvh_in_leaf_order(&mut own, options, |bvh| {
+                with_bvh4(bvh, |wide| {
+                    assert!(wide.is_leaf_order());
+                    wide.validate().unwrap();
+                    for (r, w) in rays.iter().zip(&want) {
+                        let got = query(wide, &r.ray::<S>()).unwrap();
+                        same_hit(&got, w).unwrap_or_else(|e| {
+                            panic!("{} leaf order {options:?}: {e}, ray {r}", S::NAME)
+                        });
+                    }
+                })
             });
         }
     }

@@ -5,10 +5,10 @@
 
 mod common;
 
-use common::{dir_to, hit_bits, with_bvh, with_bvh4, RaySpec, TestScalar};
-use raykernel::bvh::{nodes_needed, BuildOptions};
+use common::{dir_to, hit_bits, with_bvh, with_bvh4, with_bvh_in_leaf_order, RaySpec, TestScalar};
+use raykernel::bvh::BuildOptions;
 use raykernel::cpu::{set_traversal_simd, traversal_simd, Simd};
-use raykernel::{Accel, Bvh, Bvh4, Node, Triangle, I16F16};
+use raykernel::{Accel, Bvh4, Triangle, I16F16};
 use raykernel_testkit::icosphere::unit_icosphere;
 use raykernel_testkit::Rng;
 
@@ -79,14 +79,11 @@ fn answers<S: TestScalar>(rays: &[RaySpec], leaf_order: bool) -> Answers {
     };
     let mut tris = scene::<S>();
     let options = BuildOptions::default();
-    if !leaf_order {
-        return with_bvh(&tris, options, |bvh| with_bvh4(bvh, trace));
+    if leaf_order {
+        with_bvh_in_leaf_order(&mut tris, options, |bvh| with_bvh4(bvh, trace))
+    } else {
+        with_bvh(&tris, options, |bvh| with_bvh4(bvh, trace))
     }
-    let mut nodes = vec![Node::<S>::EMPTY; nodes_needed(tris.len())];
-    let mut ids = vec![0u32; tris.len()];
-    let bvh = Bvh::build_in_leaf_order(&mut tris, &mut nodes, &mut ids, options)
-        .unwrap_or_else(|e| panic!("{} leaf-order build: {e}", S::NAME));
-    with_bvh4(&bvh, trace)
 }
 
 /// All five features the AVX2 copy is compiled for, and the registers' OS support, as the

@@ -121,16 +121,22 @@ const TIE_BAND: f64 = 1.0 / 65_536.0;
 #[cfg_attr(not(target_os = "none"), inline(always))]
 #[cfg_attr(target_os = "none", inline)]
 fn q30_from_f32(d: [f32; 3]) -> Result<[i64; 3], RayError> {
-    if let Some(unit) = super::float::unit_dir_direct_f32(d) {
-        let v = unit.map(|u| u * DIR_ONE);
-        let k = v.map(|x| to_round(x) as i64);
-        // `v - k` is exact: at most one half apart, and `k` is zero or within a factor two.
-        let clear = |i: usize| libm::fabs(v[i] - k[i] as f64) < 0.5 - TIE_BAND;
-        if clear(0) & clear(1) & clear(2) {
-            return Ok(k);
-        }
+    match direct_q30(d) {
+        Some(k) => Ok(k),
+        None => Ok(q30(super::float::unit_dir_from_f32(d)?)),
     }
-    Ok(q30(super::float::unit_dir_from_f32(d)?))
+}
+
+/// The direct normalisation of `d` rounded to Q2.30, if `d` is finite and not zero and every
+/// component lies more than [`TIE_BAND`] from a tie (see [`q30_from_f32`]).
+#[cfg_attr(not(target_os = "none"), inline(always))]
+#[cfg_attr(target_os = "none", inline)]
+fn direct_q30(d: [f32; 3]) -> Option<[i64; 3]> {
+    let v = super::float::unit_dir_direct_f32(d)?.map(|u| u * DIR_ONE);
+    let k = v.map(|x| to_round(x) as i64);
+    // `v - k` is exact: at most one half apart, and `k` is zero or within a factor two.
+    let clear = |i: usize| libm::fabs(v[i] - k[i] as f64) < 0.5 - TIE_BAND;
+    (clear(0) & clear(1) & clear(2)).then_some(k)
 }
 
 fn saturate(x: i64) -> I16F16 {
@@ -662,14 +668,7 @@ mod tests {
             }
             if check(d).is_ok() {
                 total += 1;
-                direct += usize::from(super::super::float::unit_dir_direct_f32(d).is_some_and(
-                    |unit| {
-                        unit.iter().all(|u| {
-                            let v = u * DIR_ONE;
-                            libm::fabs(v - to_round(v) as i64 as f64) < 0.5 - TIE_BAND
-                        })
-                    },
-                ));
+                direct += usize::from(direct_q30(d).is_some());
             }
         }
         // Directions whose x lies within about 2^-30 raw units of a tie, the rounding's hard

@@ -191,6 +191,29 @@ where
     f(&bvh)
 }
 
+/// As [`with_bvh`], built with the primitives permuted into leaf order in place
+/// (`Bvh::build_in_leaf_order`).
+pub fn with_bvh_in_leaf_order<S, P, R>(
+    prims: &mut [P],
+    options: BuildOptions,
+    f: impl FnOnce(&Bvh<'_, S, P>) -> R,
+) -> R
+where
+    S: Scalar,
+    P: Primitive<S> + Copy,
+{
+    let count = prims.len();
+    let mut nodes = vec![Node::<S>::EMPTY; nodes_needed(count)];
+    let mut ids = vec![0u32; count];
+    let bvh = Bvh::build_in_leaf_order(prims, &mut nodes, &mut ids, options).unwrap_or_else(|e| {
+        panic!(
+            "{} leaf-order build ({count} prims, {options:?}) failed: {e}",
+            S::NAME
+        )
+    });
+    f(&bvh)
+}
+
 /// Collapses `bvh` into a 4-wide BVH in an arena of exactly [`nodes4_needed`] slots and hands
 /// it to `f` (validation is the caller's).
 pub fn with_bvh4<S, P, R>(bvh: &Bvh<'_, S, P>, f: impl FnOnce(&Bvh4<'_, S, P>) -> R) -> R
