@@ -17,7 +17,7 @@ use crate::obj::Mesh;
 use crate::rayfile::{HitRecord, RayRecord};
 use raykernel::bvh::BuilderKind;
 use raykernel::{
-    Accel, AccelKind, AccelMemory, AccelVisitor, AnyAccel, KdNode, Node, Node4, Primitive, Ray,
+    Accel, AccelKind, AccelMemory, AccelVisitor, AnyAccel, KdNode, Node, Node4, Node8, Primitive, Ray,
     Scalar, Triangle, I16F16,
 };
 use std::path::Path;
@@ -355,6 +355,8 @@ pub struct NodeArena<S: Scalar> {
     nodes: Vec<Node<S>>,
     /// 4-wide BVH nodes (`Node4` is 128-byte aligned, so the vector is too).
     nodes4: Vec<Node4<S>>,
+    /// 8-wide BVH nodes (128-byte aligned too).
+    nodes8: Vec<Node8<S>>,
     kd_nodes: Vec<KdNode<S>>,
     words: Vec<u32>,
 }
@@ -375,6 +377,7 @@ impl<S: Scalar> NodeArena<S> {
         Self {
             nodes: vec![Node::EMPTY; need.nodes + 1],
             nodes4: vec![Node4::EMPTY; need.nodes4],
+            nodes8: vec![Node8::EMPTY; need.nodes8],
             kd_nodes: vec![KdNode::EMPTY; need.kd_nodes],
             words: vec![0; need.words],
         }
@@ -402,6 +405,7 @@ impl<S: Scalar> NodeArena<S> {
         AccelMemory {
             nodes: &mut self.nodes[skip..skip + len],
             nodes4: &mut self.nodes4,
+            nodes8: &mut self.nodes8,
             kd_nodes: &mut self.kd_nodes,
             words: &mut self.words,
         }

@@ -33,8 +33,9 @@
 // Exceptions, each confined and documented where it is: SSE and NEON intrinsics
 // (`scalar/lanes.rs`), the in-place view of checked baked bytes (`accel/baked/plain.rs`), the
 // square-root instruction of Cortex-M cores with an FPU (`scalar/float/sqrt.rs`), and x86_64's
-// feature detection and the call of the traversal's AVX2 copy (`cpu.rs`,
-// `accel/bvh4/traverse.rs`).
+// feature detection, the calls of the traversals' AVX2 copies (`cpu.rs`,
+// `accel/wide/traverse.rs`, `accel/wide/traverse8.rs`) and their 256-bit box test
+// (`scalar/wide.rs`).
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -51,12 +52,12 @@ mod error {
 
 pub use accel::baked::{BakeError, Baked};
 pub use accel::bvh::{Bvh, Node};
-pub use accel::bvh4::{Bvh4, Node4};
+pub use accel::wide::{Bvh4, Bvh8, Node4, Node8, WideBvh, WideNode};
 pub use accel::grid::Grid;
 pub use accel::kdtree::{KdNode, KdTree};
 pub use accel::{
     Accel, AccelFamily, AccelKind, AccelMemory, AccelVisitor, AnyAccel, AnyFamily, Arena,
-    BuildError, Bvh4Family, BvhFamily, Counters, GridFamily, InvalidAccel, KdTreeFamily, Linear,
+    BuildError, Bvh4Family, Bvh8Family, BvhFamily, Counters, GridFamily, InvalidAccel, KdTreeFamily, Linear,
     LinearFamily, MemoryNeeded, Nearest, NoStats, Shortfall, TraversalStats, TrianglesOnly,
     UnknownAccel, MAX_PRIMS,
 };
@@ -88,7 +89,12 @@ pub mod baked {
 
 /// Memory size and node slots of the 4-wide BVH, [`Bvh4`].
 pub mod bvh4 {
-    pub use crate::accel::bvh4::{nodes4_needed, ChildSlot};
+    pub use crate::accel::wide::{nodes4_needed, ChildSlot};
+}
+
+/// Memory size and node slots of the 8-wide BVH, [`Bvh8`], and of wide trees in general.
+pub mod bvh8 {
+    pub use crate::accel::wide::{nodes8_needed, wide_nodes_needed, ChildSlot};
 }
 
 /// Settings, memory sizes and limits of the uniform grid, [`Grid`].

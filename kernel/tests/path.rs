@@ -46,6 +46,7 @@ fn render_tiled<S: Scalar>(
         accel: AccelMemory {
             nodes: &mut nodes,
             nodes4: &mut nodes4,
+            nodes8: &mut [],
             kd_nodes: &mut kd_nodes,
             words: &mut words,
         },

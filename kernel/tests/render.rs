@@ -93,6 +93,7 @@ impl<'m, S: Scalar> Memory<'m, S> {
             accel: AccelMemory {
                 nodes: &mut self.nodes,
                 nodes4: &mut self.nodes4,
+                nodes8: &mut [],
                 kd_nodes: &mut self.kd_nodes,
                 words: &mut self.words,
             },
@@ -1062,6 +1063,7 @@ fn buffers_and_tiles_are_checked_exactly() {
         accel: MemoryNeeded {
             nodes,
             nodes4,
+            nodes8: 0,
             kd_nodes,
             words,
         },
@@ -1071,6 +1073,10 @@ fn buffers_and_tiles_are_checked_exactly() {
     // over the two objects, 4 nodes and 2 ids.
     assert_eq!(bvh_need, need(8 + 4, 0, 0, 4 + 2));
     assert_eq!(bvh4_need, need(8 + 4, 2, 0, 4 + 2));
+    let bvh8_need = needed(AccelKind::Bvh8(options));
+    let mut bvh8_want = need(8 + 4, 0, 0, 4 + 2);
+    bvh8_want.accel.nodes8 = 2;
+    assert_eq!(bvh8_need, bvh8_want);
     assert_eq!(kd_need, need(4, 0, 18, 24 + 2));
     let g = grid_need.accel;
     assert_eq!((g.nodes, g.nodes4, g.kd_nodes), (4, 0, 0));

@@ -77,6 +77,7 @@ fn render<S: Scalar, F: AccelFamily<S>>(objects: &[Object<'_, S>], options: F::O
         accel: AccelMemory {
             nodes: &mut nodes,
             nodes4: &mut nodes4,
+            nodes8: &mut [],
             kd_nodes: &mut kd_nodes,
             words: &mut words,
         },

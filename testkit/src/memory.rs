@@ -1,14 +1,15 @@
 //! Owned caller memory for accelerator builds, sized exactly from [`MemoryNeeded`].
 
-use raykernel::{AccelKind, AccelMemory, KdNode, MemoryNeeded, Node, Node4, Primitive, Scalar};
+use raykernel::{AccelKind, AccelMemory, KdNode, MemoryNeeded, Node, Node4, Node8, Primitive, Scalar};
 use std::vec::Vec;
 
-/// The four buffers of an [`AccelMemory`], owned. Resizing keeps the allocations, so one value
+/// The five buffers of an [`AccelMemory`], owned. Resizing keeps the allocations, so one value
 /// serves a sequence of builds.
 #[derive(Debug)]
 pub struct OwnedMemory<S: Scalar> {
     nodes: Vec<Node<S>>,
     nodes4: Vec<Node4<S>>,
+    nodes8: Vec<Node8<S>>,
     kd_nodes: Vec<KdNode<S>>,
     words: Vec<u32>,
 }
@@ -26,6 +27,7 @@ impl<S: Scalar> OwnedMemory<S> {
         let mut memory = Self {
             nodes: Vec::new(),
             nodes4: Vec::new(),
+            nodes8: Vec::new(),
             kd_nodes: Vec::new(),
             words: Vec::new(),
         };
@@ -49,6 +51,7 @@ impl<S: Scalar> OwnedMemory<S> {
     pub fn resize(&mut self, need: MemoryNeeded) {
         self.nodes.resize(need.nodes, Node::EMPTY);
         self.nodes4.resize(need.nodes4, Node4::EMPTY);
+        self.nodes8.resize(need.nodes8, Node8::EMPTY);
         self.kd_nodes.resize(need.kd_nodes, KdNode::EMPTY);
         self.words.resize(need.words, 0);
     }
@@ -58,6 +61,7 @@ impl<S: Scalar> OwnedMemory<S> {
         AccelMemory {
             nodes: &mut self.nodes,
             nodes4: &mut self.nodes4,
+            nodes8: &mut self.nodes8,
             kd_nodes: &mut self.kd_nodes,
             words: &mut self.words,
         }

@@ -205,6 +205,7 @@ fn init_in<S: Scalar, F: AccelFamily<S, Options = BuildOptions>>(
             accel: AccelMemory {
                 nodes: filled(start.add(l.nodes), counts.accel.nodes, Node::EMPTY),
                 nodes4: filled(start.add(l.nodes4), counts.accel.nodes4, Node4::EMPTY),
+                nodes8: &mut [],
                 kd_nodes: &mut [],
                 words: filled(start.add(l.words), counts.accel.words, 0u32),
             },

@@ -194,6 +194,7 @@ pub fn kernel_render<S: Scalar>(data: &TestScene) -> Vec<u8> {
         accel: AccelMemory {
             nodes: &mut nodes,
             nodes4: &mut nodes4,
+            nodes8: &mut [],
             kd_nodes: &mut [],
             words: &mut words,
         },

@@ -2,8 +2,8 @@
 //! dispatches over the structures.
 
 use super::bvh::{Bvh, InvalidTree};
-use super::bvh4::Bvh4;
-use super::family::{AccelFamily, Bvh4Family, BvhFamily, GridFamily, KdTreeFamily, LinearFamily};
+use super::wide::{Bvh4, Bvh8};
+use super::family::{AccelFamily, Bvh4Family, Bvh8Family, BvhFamily, GridFamily, KdTreeFamily, LinearFamily};
 use super::grid::{Grid, InvalidGrid};
 use super::kdtree::{InvalidKdTree, KdTree};
 use super::memory::take;
@@ -20,6 +20,8 @@ pub enum AnyAccel<'a, S: Scalar, P: Primitive<S>> {
     Bvh(Bvh<'a, S, P>),
     /// A 4-wide BVH.
     Bvh4(Bvh4<'a, S, P>),
+    /// An 8-wide BVH.
+    Bvh8(Bvh8<'a, S, P>),
     /// A uniform grid.
     Grid(Grid<'a, S, P>),
     /// A kd-tree.
@@ -43,6 +45,7 @@ impl<'a, S: Scalar, P: Primitive<S>> AnyAccel<'a, S, P> {
             AccelKind::Linear => LinearFamily::build(&(), prims, memory).map(Self::Linear),
             AccelKind::Bvh(o) => BvhFamily::build(&o, prims, memory).map(Self::Bvh),
             AccelKind::Bvh4(o) => Bvh4Family::build(&o, prims, memory).map(Self::Bvh4),
+            AccelKind::Bvh8(o) => Bvh8Family::build(&o, prims, memory).map(Self::Bvh8),
             AccelKind::Grid(o) => GridFamily::build(&o, prims, memory).map(Self::Grid),
             AccelKind::KdTree(o) => KdTreeFamily::build(&o, prims, memory).map(Self::KdTree),
         }
@@ -76,6 +79,13 @@ impl<'a, S: Scalar, P: Primitive<S>> AnyAccel<'a, S, P> {
                 let binary = Bvh::build_in_leaf_order(prims, nodes, ids, options)?;
                 Ok(Self::Bvh4(Bvh4::collapse(&binary, nodes4)?))
             }
+            AccelKind::Bvh8(options) => {
+                let nodes = take(&mut memory.nodes, need.nodes);
+                let ids = take(&mut memory.words, need.words);
+                let nodes8 = take(&mut memory.nodes8, MemoryNeeded::bvh8(prims.len()).nodes8);
+                let binary = Bvh::build_in_leaf_order(prims, nodes, ids, options)?;
+                Ok(Self::Bvh8(Bvh8::collapse(&binary, nodes8)?))
+            }
             AccelKind::Linear | AccelKind::Grid(_) | AccelKind::KdTree(_) => {
                 Self::build(kind, prims, memory)
             }
@@ -89,6 +99,7 @@ impl<'a, S: Scalar, P: Primitive<S>> AnyAccel<'a, S, P> {
             Self::Linear(_) => "linear",
             Self::Bvh(_) => "bvh",
             Self::Bvh4(_) => "bvh4",
+            Self::Bvh8(_) => "bvh8",
             Self::Grid(_) => "grid",
             Self::KdTree(_) => "kdtree",
         }
@@ -101,12 +112,13 @@ impl<'a, S: Scalar, P: Primitive<S>> AnyAccel<'a, S, P> {
             Self::Linear(_) => 0,
             Self::Bvh(a) => a.nodes().len(),
             Self::Bvh4(a) => a.nodes().len(),
+            Self::Bvh8(a) => a.nodes().len(),
             Self::Grid(a) => a.cells().len().saturating_sub(1),
             Self::KdTree(a) => a.nodes().len(),
         }
     }
 
-    /// Bytes a query reads besides the primitives (0 for brute force; the 4-wide BVH's build
+    /// Bytes a query reads besides the primitives (0 for brute force; the wide BVHs' build
     /// scratch is not counted).
     #[must_use]
     pub fn bytes_used(&self) -> usize {
@@ -114,6 +126,7 @@ impl<'a, S: Scalar, P: Primitive<S>> AnyAccel<'a, S, P> {
             Self::Linear(_) => 0,
             Self::Bvh(a) => a.bytes_used(),
             Self::Bvh4(a) => a.bytes_used(),
+            Self::Bvh8(a) => a.bytes_used(),
             Self::Grid(a) => a.bytes_used(),
             Self::KdTree(a) => a.bytes_used(),
         }
@@ -126,6 +139,7 @@ impl<'a, S: Scalar, P: Primitive<S>> AnyAccel<'a, S, P> {
             Self::Linear(_) | Self::Grid(_) => 0,
             Self::Bvh(a) => a.depth(),
             Self::Bvh4(a) => a.depth(),
+            Self::Bvh8(a) => a.depth(),
             Self::KdTree(a) => a.depth(),
         }
     }
@@ -142,6 +156,7 @@ impl<S: Scalar, P: Primitive<S>> AnyAccel<'_, S, P> {
             Self::Linear(_) => Ok(()),
             Self::Bvh(a) => a.validate().map(drop).map_err(InvalidAccel::Tree),
             Self::Bvh4(a) => a.validate().map(drop).map_err(InvalidAccel::Tree),
+            Self::Bvh8(a) => a.validate().map(drop).map_err(InvalidAccel::Tree),
             Self::Grid(a) => a.validate().map(drop).map_err(InvalidAccel::Grid),
             Self::KdTree(a) => a.validate().map(drop).map_err(InvalidAccel::KdTree),
         }
@@ -152,7 +167,7 @@ impl<S: Scalar, P: Primitive<S>> AnyAccel<'_, S, P> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum InvalidAccel {
-    /// From [`Bvh::validate`] or [`Bvh4::validate`].
+    /// From [`Bvh::validate`], [`Bvh4::validate`] or [`Bvh8::validate`].
     Tree(InvalidTree),
     /// From [`Grid::validate`].
     Grid(InvalidGrid),
@@ -189,6 +204,7 @@ impl<S: Scalar, P: Primitive<S>> AnyAccel<'_, S, P> {
             Self::Linear(a) => visitor.visit(a),
             Self::Bvh(a) => visitor.visit(a),
             Self::Bvh4(a) => visitor.visit(a),
+            Self::Bvh8(a) => visitor.visit(a),
             Self::Grid(a) => visitor.visit(a),
             Self::KdTree(a) => visitor.visit(a),
         }
@@ -202,6 +218,7 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for AnyAccel<'_, S, P> {
             Self::Linear(a) => a.nearest_counted(ray, stats),
             Self::Bvh(a) => a.nearest_counted(ray, stats),
             Self::Bvh4(a) => a.nearest_counted(ray, stats),
+            Self::Bvh8(a) => a.nearest_counted(ray, stats),
             Self::Grid(a) => a.nearest_counted(ray, stats),
             Self::KdTree(a) => a.nearest_counted(ray, stats),
         }
@@ -213,6 +230,7 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for AnyAccel<'_, S, P> {
             Self::Linear(a) => a.occluded_counted(ray, stats),
             Self::Bvh(a) => a.occluded_counted(ray, stats),
             Self::Bvh4(a) => a.occluded_counted(ray, stats),
+            Self::Bvh8(a) => a.occluded_counted(ray, stats),
             Self::Grid(a) => a.occluded_counted(ray, stats),
             Self::KdTree(a) => a.occluded_counted(ray, stats),
         }
@@ -224,6 +242,7 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for AnyAccel<'_, S, P> {
             Self::Linear(a) => a.barycentrics(ray, found),
             Self::Bvh(a) => a.barycentrics(ray, found),
             Self::Bvh4(a) => a.barycentrics(ray, found),
+            Self::Bvh8(a) => a.barycentrics(ray, found),
             Self::Grid(a) => a.barycentrics(ray, found),
             Self::KdTree(a) => a.barycentrics(ray, found),
         }

@@ -3,7 +3,7 @@
 
 use super::any::AnyAccel;
 use super::bvh::{BuildOptions, BuildSettings, Bvh};
-use super::bvh4::Bvh4;
+use super::wide::{Bvh4, Bvh8};
 use super::grid::{Grid, GridOptions};
 use super::kdtree::{KdOptions, KdTree};
 use super::memory::take;
@@ -68,6 +68,10 @@ pub struct BvhFamily<B = BuildOptions>(PhantomData<B>);
 /// The 4-wide BVH, [`Bvh4`].
 #[derive(Clone, Copy, Debug)]
 pub struct Bvh4Family;
+
+/// The 8-wide BVH, [`Bvh8`].
+#[derive(Clone, Copy, Debug)]
+pub struct Bvh8Family;
 
 /// The uniform grid, [`Grid`].
 #[derive(Clone, Copy, Debug)]
@@ -172,6 +176,33 @@ impl<S: Scalar> AccelFamily<S> for Bvh4Family {
         let nodes4 = take(&mut memory.nodes4, need.nodes4);
         let binary = Bvh::build(prims, nodes, ids, *options)?;
         Bvh4::collapse(&binary, nodes4)
+    }
+}
+
+impl<S: Scalar> AccelFamily<S> for Bvh8Family {
+    type Accel<'a, P: Primitive<S> + 'a> = Bvh8<'a, S, P>;
+    type Options = BuildOptions;
+    type TopLevel = BuildOptions;
+
+    fn memory_needed<P: Primitive<S>>(
+        _: &BuildOptions,
+        prims: &[P],
+    ) -> Result<MemoryNeeded, BuildError> {
+        check_count(prims.len())?;
+        Ok(MemoryNeeded::bvh8(prims.len()))
+    }
+
+    fn build<'a, P: Primitive<S> + 'a>(
+        options: &BuildOptions,
+        prims: &'a [P],
+        memory: &mut AccelMemory<'a, S>,
+    ) -> Result<Bvh8<'a, S, P>, BuildError> {
+        let need = MemoryNeeded::bvh8(prims.len());
+        let nodes = take(&mut memory.nodes, need.nodes);
+        let ids = take(&mut memory.words, need.words);
+        let nodes8 = take(&mut memory.nodes8, need.nodes8);
+        let binary = Bvh::build(prims, nodes, ids, *options)?;
+        Bvh8::collapse(&binary, nodes8)
     }
 }
 

@@ -1,7 +1,7 @@
 //! The run-time description of an accelerator: which structure, with which options.
 
 use super::bvh::BuildOptions;
-use super::family::{AccelFamily, Bvh4Family, BvhFamily, GridFamily, KdTreeFamily, LinearFamily};
+use super::family::{AccelFamily, Bvh4Family, Bvh8Family, BvhFamily, GridFamily, KdTreeFamily, LinearFamily};
 use super::grid::GridOptions;
 use super::kdtree::KdOptions;
 use super::{BuildError, MemoryNeeded};
@@ -20,6 +20,8 @@ pub enum AccelKind {
     Bvh(BuildOptions),
     /// A 4-wide BVH, [`crate::Bvh4`], collapsed from a binary BVH built with these options.
     Bvh4(BuildOptions),
+    /// An 8-wide BVH, [`crate::Bvh8`], collapsed from a binary BVH built with these options.
+    Bvh8(BuildOptions),
     /// A uniform grid, [`crate::Grid`].
     Grid(GridOptions),
     /// A kd-tree, [`crate::KdTree`].
@@ -52,21 +54,23 @@ impl core::error::Error for UnknownAccel {}
 
 impl AccelKind {
     /// Every structure with its default options, the fastest first.
-    pub const ALL: [Self; 5] = [
+    pub const ALL: [Self; 6] = [
         Self::Bvh4(BuildOptions::DEFAULT),
+        Self::Bvh8(BuildOptions::DEFAULT),
         Self::Bvh(BuildOptions::DEFAULT),
         Self::KdTree(KdOptions::DEFAULT),
         Self::Grid(GridOptions::DEFAULT),
         Self::Linear,
     ];
 
-    /// The name on command lines: `linear`, `bvh`, `bvh4`, `grid` or `kdtree`.
+    /// The name on command lines: `linear`, `bvh`, `bvh4`, `bvh8`, `grid` or `kdtree`.
     #[must_use]
     pub const fn name(&self) -> &'static str {
         match self {
             Self::Linear => "linear",
             Self::Bvh(_) => "bvh",
             Self::Bvh4(_) => "bvh4",
+            Self::Bvh8(_) => "bvh8",
             Self::Grid(_) => "grid",
             Self::KdTree(_) => "kdtree",
         }
@@ -83,11 +87,11 @@ impl AccelKind {
             .ok_or(UnknownAccel)
     }
 
-    /// The BVH build options, for the two BVH structures.
+    /// The BVH build options, for the three BVH structures.
     #[must_use]
     pub const fn build_options(&self) -> Option<BuildOptions> {
         match self {
-            Self::Bvh(o) | Self::Bvh4(o) => Some(*o),
+            Self::Bvh(o) | Self::Bvh4(o) | Self::Bvh8(o) => Some(*o),
             Self::Linear | Self::Grid(_) | Self::KdTree(_) => None,
         }
     }
@@ -98,6 +102,7 @@ impl AccelKind {
         match self {
             Self::Bvh(_) => Self::Bvh(options),
             Self::Bvh4(_) => Self::Bvh4(options),
+            Self::Bvh8(_) => Self::Bvh8(options),
             other => other,
         }
     }
@@ -111,7 +116,7 @@ impl AccelKind {
     /// True if [`crate::AnyAccel::build_in_leaf_order`] permutes the primitives (the BVHs).
     #[must_use]
     pub const fn permutes_into_leaf_order(&self) -> bool {
-        matches!(self, Self::Bvh(_) | Self::Bvh4(_))
+        matches!(self, Self::Bvh(_) | Self::Bvh4(_) | Self::Bvh8(_))
     }
 
     /// The exact memory a build over `count` primitives takes, for the structures whose size
@@ -122,6 +127,7 @@ impl AccelKind {
             Self::Linear => Some(MemoryNeeded::NONE),
             Self::Bvh(_) => Some(MemoryNeeded::bvh(count)),
             Self::Bvh4(_) => Some(MemoryNeeded::bvh4(count)),
+            Self::Bvh8(_) => Some(MemoryNeeded::bvh8(count)),
             Self::KdTree(_) => Some(MemoryNeeded::kdtree(count)),
             Self::Grid(_) => None,
         }
@@ -139,6 +145,7 @@ impl AccelKind {
             Self::Linear => LinearFamily::memory_needed(&(), prims),
             Self::Bvh(o) => BvhFamily::memory_needed(o, prims),
             Self::Bvh4(o) => Bvh4Family::memory_needed(o, prims),
+            Self::Bvh8(o) => Bvh8Family::memory_needed(o, prims),
             Self::Grid(o) => GridFamily::memory_needed(o, prims),
             Self::KdTree(o) => KdTreeFamily::memory_needed(o, prims),
         }
@@ -152,7 +159,7 @@ impl fmt::Display for AccelKind {
         f.write_str(self.name())?;
         match self {
             Self::Linear => Ok(()),
-            Self::Bvh(o) | Self::Bvh4(o) => {
+            Self::Bvh(o) | Self::Bvh4(o) | Self::Bvh8(o) => {
                 write!(f, " {} leaf {}", o.builder.name(), o.max_leaf_size)?;
                 if o.reinsertion {
                     Ok(())

@@ -1,7 +1,7 @@
 //! The caller's memory for accelerators, and how much of it a build takes.
 
 use super::bvh::{nodes_needed, Node};
-use super::bvh4::{nodes4_needed, Node4};
+use super::wide::{nodes4_needed, nodes8_needed, Node4, Node8};
 use super::grid::GridSize;
 use super::kdtree::{self, KdNode};
 use crate::scalar::Scalar;
@@ -15,6 +15,8 @@ pub struct AccelMemory<'a, S: Scalar> {
     pub nodes: &'a mut [Node<S>],
     /// 4-wide BVH nodes.
     pub nodes4: &'a mut [Node4<S>],
+    /// 8-wide BVH nodes.
+    pub nodes8: &'a mut [Node8<S>],
     /// Kd-tree nodes.
     pub kd_nodes: &'a mut [KdNode<S>],
     /// Index words: BVH primitive ids, grid cell offsets and references, kd-tree references.
@@ -27,6 +29,7 @@ impl<S: Scalar> Default for AccelMemory<'_, S> {
         Self {
             nodes: &mut [],
             nodes4: &mut [],
+            nodes8: &mut [],
             kd_nodes: &mut [],
             words: &mut [],
         }
@@ -49,6 +52,7 @@ impl<S: Scalar> AccelMemory<'_, S> {
         MemoryNeeded {
             nodes: self.nodes.len(),
             nodes4: self.nodes4.len(),
+            nodes8: self.nodes8.len(),
             kd_nodes: self.kd_nodes.len(),
             words: self.words.len(),
         }
@@ -64,6 +68,8 @@ pub struct MemoryNeeded {
     pub nodes: usize,
     /// Length of [`AccelMemory::nodes4`].
     pub nodes4: usize,
+    /// Length of [`AccelMemory::nodes8`].
+    pub nodes8: usize,
     /// Length of [`AccelMemory::kd_nodes`].
     pub kd_nodes: usize,
     /// Length of [`AccelMemory::words`].
@@ -73,7 +79,8 @@ pub struct MemoryNeeded {
 /// A buffer shorter than required, as [`MemoryNeeded::first_shortfall`] finds it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Shortfall {
-    /// The [`MemoryNeeded`] field naming the buffer: `nodes`, `nodes4`, `kd_nodes` or `words`.
+    /// The [`MemoryNeeded`] field naming the buffer: `nodes`, `nodes4`, `nodes8`, `kd_nodes`
+    /// or `words`.
     pub field: &'static str,
     /// Length required.
     pub needed: usize,
@@ -86,6 +93,7 @@ impl MemoryNeeded {
     pub const NONE: Self = Self {
         nodes: 0,
         nodes4: 0,
+        nodes8: 0,
         kd_nodes: 0,
         words: 0,
     };
@@ -106,6 +114,16 @@ impl MemoryNeeded {
     pub const fn bvh4(count: usize) -> Self {
         Self {
             nodes4: nodes4_needed(count),
+            ..Self::bvh(count)
+        }
+    }
+
+    /// An 8-wide BVH over `count` primitives: the binary BVH it is collapsed from (its nodes
+    /// are build scratch) and [`nodes8_needed`] wide nodes.
+    #[must_use]
+    pub const fn bvh8(count: usize) -> Self {
+        Self {
+            nodes8: nodes8_needed(count),
             ..Self::bvh(count)
         }
     }
@@ -135,6 +153,7 @@ impl MemoryNeeded {
         Self {
             nodes: self.nodes.saturating_add(o.nodes),
             nodes4: self.nodes4.saturating_add(o.nodes4),
+            nodes8: self.nodes8.saturating_add(o.nodes8),
             kd_nodes: self.kd_nodes.saturating_add(o.kd_nodes),
             words: self.words.saturating_add(o.words),
         }
@@ -146,6 +165,7 @@ impl MemoryNeeded {
         self.nodes
             .saturating_mul(size_of::<Node<S>>())
             .saturating_add(self.nodes4.saturating_mul(size_of::<Node4<S>>()))
+            .saturating_add(self.nodes8.saturating_mul(size_of::<Node8<S>>()))
             .saturating_add(self.kd_nodes.saturating_mul(size_of::<KdNode<S>>()))
             .saturating_add(self.words.saturating_mul(4))
     }
@@ -156,6 +176,7 @@ impl MemoryNeeded {
         let pairs = [
             ("nodes", self.nodes, available.nodes),
             ("nodes4", self.nodes4, available.nodes4),
+            ("nodes8", self.nodes8, available.nodes8),
             ("kd_nodes", self.kd_nodes, available.kd_nodes),
             ("words", self.words, available.words),
         ];

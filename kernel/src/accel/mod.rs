@@ -7,7 +7,7 @@
 mod any;
 pub(crate) mod baked;
 pub(crate) mod bvh;
-pub(crate) mod bvh4;
+pub(crate) mod wide;
 mod error;
 mod family;
 pub(crate) mod grid;
@@ -20,7 +20,7 @@ mod memory;
 pub use any::{AccelVisitor, AnyAccel, InvalidAccel};
 pub use error::{Arena, BuildError};
 pub use family::{
-    AccelFamily, AnyFamily, Bvh4Family, BvhFamily, GridFamily, KdTreeFamily, LinearFamily,
+    AccelFamily, AnyFamily, Bvh4Family, Bvh8Family, BvhFamily, GridFamily, KdTreeFamily, LinearFamily,
     TrianglesOnly,
 };
 pub use input::MAX_PRIMS;

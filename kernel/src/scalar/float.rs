@@ -863,6 +863,20 @@ impl Numerics for f32 {
         super::wide::slab4(r.o_lo, r.o_hi, r.inv, WIDEN, lo, hi, t_min, t_max)
     }
 
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
+    #[inline(always)]
+    unsafe fn slab8_avx(
+        r: &FloatRay,
+        lo: &[[f32; 8]; 3],
+        hi: &[[f32; 8]; 3],
+        t_min: f32,
+        t_max: f32,
+    ) -> (u32, [f32; 8]) {
+        // SAFETY: the caller guarantees AVX, the one feature `slab8_avx` enables.
+        unsafe { super::wide::slab8_avx(r.o_lo, r.o_hi, r.inv, WIDEN, lo, hi, t_min, t_max) }
+    }
+
     fn sphere_bounds(center: &[f32; 3], radius: f32) -> ([f32; 3], [f32; 3]) {
         let mut lo = [0.0; 3];
         let mut hi = [0.0; 3];

@@ -139,6 +139,42 @@ pub(crate) mod sealed {
             }
             (mask, t)
         }
+        /// [`Numerics::slab4`] of eight boxes (an 8-wide BVH node's children): on lanes 0..4,
+        /// then on lanes 4..8, so each box gets exactly its `slab4` decision and entry.
+        #[inline(always)]
+        fn slab8(
+            ray: &Self::RayData,
+            lo: &[[Self; 8]; 3],
+            hi: &[[Self; 8]; 3],
+            t_min: Self,
+            t_max: Self,
+        ) -> (u32, [Self; 8]) {
+            let half = |planes: &[[Self; 8]; 3], h: usize| {
+                planes.map(|axis| core::array::from_fn::<Self, 4, _>(|i| axis[(4 * h + i) % 8]))
+            };
+            let (low, t_low) = Self::slab4(ray, &half(lo, 0), &half(hi, 0), t_min, t_max);
+            let (high, t_high) = Self::slab4(ray, &half(lo, 1), &half(hi, 1), t_min, t_max);
+            let t = core::array::from_fn(|i| if i < 4 { t_low[i % 4] } else { t_high[i % 4] });
+            (low | high << 4, t)
+        }
+        /// [`Numerics::slab8`], bit for bit, for code compiled with AVX: `f32` tests the eight
+        /// boxes in the 256-bit lanes of one vector (`wide::slab8_avx`), each lane doing the
+        /// operations of `slab4`'s lanes in their order; the default is `slab8`.
+        ///
+        /// # Safety
+        /// The CPU must have AVX.
+        #[cfg(target_arch = "x86_64")]
+        #[allow(unsafe_code)]
+        #[inline(always)]
+        unsafe fn slab8_avx(
+            ray: &Self::RayData,
+            lo: &[[Self; 8]; 3],
+            hi: &[[Self; 8]; 3],
+            t_min: Self,
+            t_max: Self,
+        ) -> (u32, [Self; 8]) {
+            Self::slab8(ray, lo, hi, t_min, t_max)
+        }
         /// `t >= 0` widened by the slab test's margin: the test accepts boxes entered up to
         /// `widen(t)`.
         #[must_use]

@@ -64,6 +64,58 @@ pub(super) fn slab4(
     (mask, t_near.to_array())
 }
 
+/// [`slab4`] of eight boxes in the 256-bit lanes of AVX: each lane performs the operations of
+/// one [`slab4`] lane, in its order (`vsubps`, `vmulps`, `vminps`/`vmaxps` with the same operand
+/// order, so the same result when unordered, and an ordered `<=`), so every box gets the bits
+/// [`slab4`] gives it. Bit `i` of the mask is box `i`.
+///
+/// # Safety
+/// The CPU must have AVX.
+#[cfg(target_arch = "x86_64")]
+#[allow(clippy::too_many_arguments, unsafe_code)]
+#[target_feature(enable = "avx")]
+#[inline]
+pub(super) unsafe fn slab8_avx(
+    o_lo: [f32; 4],
+    o_hi: [f32; 4],
+    inv: [f32; 4],
+    widen: f32,
+    lo: &[[f32; 8]; 3],
+    hi: &[[f32; 8]; 3],
+    t_min: f32,
+    t_max: f32,
+) -> (u32, [f32; 8]) {
+    use core::arch::x86_64::{
+        _mm256_cmp_ps, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps,
+        _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps, _CMP_LE_OQ,
+    };
+    // SAFETY: AVX is present (the caller's guarantee); every load and store is of eight `f32`
+    // inside an `[f32; 8]`.
+    unsafe {
+        let mut t_near = _mm256_set1_ps(t_min);
+        let mut t_far = _mm256_set1_ps(t_max);
+        for k in 0..3 {
+            let k = k.min(2); // a no-op that shows the compiler the bound
+            let inv = _mm256_set1_ps(inv[k]);
+            let a = _mm256_mul_ps(
+                _mm256_sub_ps(_mm256_loadu_ps(lo[k].as_ptr()), _mm256_set1_ps(o_lo[k])),
+                inv,
+            );
+            let b = _mm256_mul_ps(
+                _mm256_sub_ps(_mm256_loadu_ps(hi[k].as_ptr()), _mm256_set1_ps(o_hi[k])),
+                inv,
+            );
+            // `enter_exit`'s folds: `near.max(acc)`, `far.min(acc)`, x first.
+            t_near = _mm256_max_ps(_mm256_min_ps(a, b), t_near);
+            t_far = _mm256_min_ps(_mm256_max_ps(a, b), t_far);
+        }
+        let inside = _mm256_cmp_ps::<_CMP_LE_OQ>(t_near, _mm256_mul_ps(t_far, _mm256_set1_ps(widen)));
+        let mut t = [0.0f32; 8];
+        _mm256_storeu_ps(t.as_mut_ptr(), t_near);
+        (_mm256_movemask_ps(inside) as u32, t)
+    }
+}
+
 /// `Numerics::slab4` for fixed point where [`F4`] has vector lanes: the four boxes' raw Q16.16
 /// planes against the ray's shifted raw origins `o_lo`, `o_hi` (see `FixedRay`), with `inv`
 /// the reciprocal direction `2^30 / dir` rounded to `f32`; distances in raw Q16.16 units.

@@ -49,6 +49,7 @@ fn exercise<S: Scalar>(data: &SceneData<'_>, settings: Settings, accel: AccelKin
         accel: AccelMemory {
             nodes: &mut nodes[..n.min(2 * (TRIS + SPHERES) + 4 * OBJECTS)],
             nodes4: &mut nodes4[..n.min(TRIS + SPHERES + OBJECTS)],
+            nodes8: &mut [],
             kd_nodes: &mut kd_nodes[..n.min(4 * (TRIS + SPHERES) + OBJECTS)],
             words: &mut words[..n.min(WORDS)],
         },

@@ -6,7 +6,7 @@
 
 use super::error::BakeError;
 use crate::accel::bvh::{BuildOptions, Node};
-use crate::accel::bvh4::Node4;
+use crate::accel::wide::Node4;
 use crate::accel::AccelKind;
 
 /// The first eight bytes of every baked file.

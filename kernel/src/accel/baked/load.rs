@@ -5,7 +5,7 @@ use super::format::{checked_header, BakedKind, Header};
 use super::plain::{cast_section, Plain};
 use super::scalar::BakedScalar;
 use crate::accel::bvh::{Bvh, Node};
-use crate::accel::bvh4::{Bvh4, Node4};
+use crate::accel::wide::{Bvh4, Node4};
 use crate::geom::{Primitive, Triangle};
 
 /// Loads a baked binary BVH of mode `S` from `bytes` without copying: the returned tree's

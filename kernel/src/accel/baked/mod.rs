@@ -25,7 +25,7 @@ pub use scalar::BakedScalar;
 pub use write::{bake_bvh, bake_bvh4, baked_len};
 
 use crate::accel::bvh::{Bvh, Node, RefitError, TreeShape};
-use crate::accel::bvh4::{Bvh4, Node4};
+use crate::accel::wide::{Bvh4, Node4};
 use crate::accel::{Accel, AnyAccel, Counters, Nearest};
 use crate::geom::{Barycentrics, Ray, Triangle};
 
@@ -56,7 +56,7 @@ impl<'a, S: BakedScalar> Baked<'a, S> {
         match accel {
             AnyAccel::Bvh(t) => Some(Self::Bvh(t)),
             AnyAccel::Bvh4(t) => Some(Self::Bvh4(t)),
-            AnyAccel::Linear(_) | AnyAccel::Grid(_) | AnyAccel::KdTree(_) => None,
+            AnyAccel::Linear(_) | AnyAccel::Bvh8(_) | AnyAccel::Grid(_) | AnyAccel::KdTree(_) => None,
         }
     }
 

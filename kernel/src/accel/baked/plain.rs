@@ -10,7 +10,7 @@
 
 use super::format::TRIANGLE_LEN;
 use crate::accel::bvh::Node;
-use crate::accel::bvh4::Node4;
+use crate::accel::wide::Node4;
 use crate::geom::Triangle;
 use crate::scalar::{Scalar, I16F16};
 

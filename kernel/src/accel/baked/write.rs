@@ -4,7 +4,7 @@ use super::error::BakeError;
 use super::format::{checksum, field, BakedKind, Layout, FLAG_LEAF_ORDER, MAGIC, VERSION};
 use super::scalar::BakedScalar;
 use crate::accel::bvh::Bvh;
-use crate::accel::bvh4::Bvh4;
+use crate::accel::wide::Bvh4;
 use crate::geom::Triangle;
 
 /// Bytes of the baked file of a tree of `kind` with `node_count` nodes over `prim_count`

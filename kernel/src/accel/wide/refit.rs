@@ -1,14 +1,14 @@
-//! Refit of the 4-wide tree: every slot box recomputed bottom-up after the primitives moved
+//! Refit of a wide tree: every slot box recomputed bottom-up after the primitives moved
 //! (see the binary tree's refit for the rule).
 
-use super::{Bvh4, ChildSlot, Node4};
+use super::{ChildSlot, WideBvh, WideNode};
 use crate::accel::bvh::{leaf_bounds, refit_nodes};
 use crate::accel::bvh::{RefitError, TreeShape};
 use crate::geom::{Aabb, Primitive};
 use crate::scalar::Scalar;
 
-impl<'a, S: Scalar, P: Primitive<S>> Bvh4<'a, S, P> {
-    /// Node count, depth and primitive order: what [`Bvh4::refit`] needs to know.
+impl<'a, S: Scalar, P: Primitive<S>, const W: usize> WideBvh<'a, S, P, W> {
+    /// Node count, depth and primitive order: what [`WideBvh::refit`] needs to know.
     #[must_use]
     pub fn shape(&self) -> TreeShape {
         TreeShape {
@@ -26,7 +26,7 @@ impl<'a, S: Scalar, P: Primitive<S>> Bvh4<'a, S, P> {
     /// [`RefitError::BadPrimitive`] (nothing changed), [`RefitError::ShapeMismatch`].
     pub fn refit(
         prims: &'a [P],
-        nodes: &'a mut [Node4<S>],
+        nodes: &'a mut [WideNode<S, W>],
         prim_ids: &'a [u32],
         shape: TreeShape,
     ) -> Result<Self, RefitError> {
@@ -55,7 +55,7 @@ impl<'a, S: Scalar, P: Primitive<S>> Bvh4<'a, S, P> {
                 *n = out;
             }
         }
-        let nodes: &'a [Node4<S>] = nodes;
+        let nodes: &'a [WideNode<S, W>] = nodes;
         Ok(Self::from_parts(
             nodes,
             prim_ids,
@@ -67,7 +67,7 @@ impl<'a, S: Scalar, P: Primitive<S>> Bvh4<'a, S, P> {
 }
 
 /// The union of a node's used slot boxes (`None` for a node without any).
-fn node_bounds<S: Scalar>(node: &Node4<S>) -> Option<Aabb<S>> {
+fn node_bounds<S: Scalar, const W: usize>(node: &WideNode<S, W>) -> Option<Aabb<S>> {
     (0..node.child_count())
         .filter_map(|s| node.bounds(s))
         .reduce(|a, b| a.union(&b))

@@ -5,7 +5,7 @@ use crate::scalar::Scalar;
 /// `count` of an unused child slot.
 pub(crate) const EMPTY_SLOT: u32 = u32::MAX;
 
-/// One of a [`Node4`]'s four child slots, as [`Node4::slot`] reads it.
+/// One of a [`WideNode`]'s child slots, as [`WideNode::slot`] reads it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ChildSlot {
     /// Node index (inner child) or first primitive-id slot (leaf).
@@ -14,11 +14,12 @@ pub struct ChildSlot {
     pub count: u32,
 }
 
-/// One 4-wide BVH node: the boxes of up to four children in structure-of-arrays form, so one
-/// vector instruction tests an axis of all four. 128 bytes in both modes, aligned to 128: two
-/// cache lines that x86's adjacent-line prefetcher fetches together.
+/// One wide BVH node of `W` child slots (`W` = 4 or 8): the boxes of its children in
+/// structure-of-arrays form, so one vector instruction tests an axis of four (or eight) at
+/// once. `32·W` bytes in both modes (128 for [`Node4`], 256 for [`Node8`]), aligned to 128:
+/// whole pairs of cache lines, which x86's adjacent-line prefetcher fetches together.
 ///
-/// Layout: `lo[axis][slot]`, `hi[axis][slot]` (96 bytes for `f32` and `I16F16`), then
+/// Layout: `lo[axis][slot]`, `hi[axis][slot]` (`24·W` bytes for `f32` and `I16F16`), then
 /// `child[slot]` and `count[slot]`.
 ///
 /// Invariants, per slot `i`:
@@ -38,34 +39,46 @@ pub struct ChildSlot {
 /// `Numerics::pad_bounds`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(128))]
-pub struct Node4<S: Scalar> {
-    pub(crate) lo: [[S; 4]; 3],
-    pub(crate) hi: [[S; 4]; 3],
-    pub(crate) child: [u32; 4],
-    pub(crate) count: [u32; 4],
+pub struct WideNode<S: Scalar, const W: usize> {
+    pub(crate) lo: [[S; W]; 3],
+    pub(crate) hi: [[S; W]; 3],
+    pub(crate) child: [u32; W],
+    pub(crate) count: [u32; W],
 }
+
+/// A node of the 4-wide BVH, [`crate::Bvh4`].
+pub type Node4<S> = WideNode<S, 4>;
+/// A node of the 8-wide BVH, [`crate::Bvh8`].
+pub type Node8<S> = WideNode<S, 8>;
 
 const _: () = assert!(core::mem::size_of::<Node4<f32>>() == 128);
 const _: () = assert!(core::mem::size_of::<Node4<crate::I16F16>>() == 128);
+const _: () = assert!(core::mem::size_of::<Node8<f32>>() == 256);
+const _: () = assert!(core::mem::size_of::<Node8<crate::I16F16>>() == 256);
 
-impl<S: Scalar> Node4<S> {
+impl<S: Scalar, const W: usize> WideNode<S, W> {
     /// A placeholder to fill arenas with, e.g. `[Node4::EMPTY; nodes4_needed(N)]`.
     pub const EMPTY: Self = Self {
-        lo: [[S::ZERO; 4]; 3],
-        hi: [[S::ZERO; 4]; 3],
-        child: [0; 4],
-        count: [EMPTY_SLOT; 4],
+        lo: [[S::ZERO; W]; 3],
+        hi: [[S::ZERO; W]; 3],
+        child: [0; W],
+        count: [EMPTY_SLOT; W],
     };
 
     /// Bit `i` set if slot `i` is used: the sign bits of `count` (a used slot's count is at
     /// most [`crate::bvh::MAX_LEAF_SIZE`], [`EMPTY_SLOT`] has its top bit set), inverted; one
-    /// vector move-mask where `F4` has SSE.
+    /// vector move-mask per four slots where `F4` has SSE.
     #[inline(always)]
     pub(crate) fn used_mask(&self) -> u32 {
-        !F4::new(self.count.map(f32::from_bits)).sign_mask() & 0b1111
+        let mut signs = 0u32;
+        for (quad, counts) in self.count.chunks_exact(4).enumerate() {
+            let lanes = [0, 1, 2, 3].map(|i| counts.get(i).map_or(0.0, |&c| f32::from_bits(c)));
+            signs |= F4::new(lanes).sign_mask() << (4 * quad);
+        }
+        !signs & ((1 << W) - 1)
     }
 
-    /// Sets slot `i` (0..4; others are ignored).
+    /// Sets slot `i` (`0..W`; others are ignored).
     pub(crate) fn set(&mut self, i: usize, b: &Aabb<S>, child: u32, count: u32) {
         for axis in 0..3 {
             if let (Some(lo), Some(hi)) = (self.lo[axis].get_mut(i), self.hi[axis].get_mut(i)) {
@@ -86,21 +99,21 @@ impl<S: Scalar> Node4<S> {
         self.set(i, &inverted, 0, EMPTY_SLOT);
     }
 
-    /// Slots in use (leading slots; at most 4).
+    /// Slots in use (leading slots; at most `W`).
     #[must_use]
     pub fn child_count(&self) -> usize {
         self.count.iter().take_while(|&&c| c != EMPTY_SLOT).count()
     }
-    /// Box of slot `i`, if `i < 4`.
+    /// Box of slot `i`, if `i < W`.
     #[must_use]
     pub fn bounds(&self, i: usize) -> Option<Aabb<S>> {
-        let i = (i < 4).then_some(i)?;
+        let i = (i < W).then_some(i)?;
         let lo = [self.lo[0].get(i), self.lo[1].get(i), self.lo[2].get(i)];
         let hi = [self.hi[0].get(i), self.hi[1].get(i), self.hi[2].get(i)];
         let g = |x: Option<&S>| x.copied().unwrap_or(S::ZERO);
         Some(Aabb::new(lo.map(g), hi.map(g)))
     }
-    /// Slot `i`, if `i < 4`.
+    /// Slot `i`, if `i < W`.
     #[must_use]
     pub fn slot(&self, i: usize) -> Option<ChildSlot> {
         Some(ChildSlot {

@@ -1,7 +1,7 @@
-//! BVH2 → 4-wide collapse, breadth-first, with the output arena as the work queue.
+//! BVH2 → wide collapse, breadth-first, with the output arena as the work queue.
 
-use super::node::Node4;
-use super::nodes4_needed;
+use super::node::WideNode;
+use super::wide_nodes_needed;
 use crate::accel::bvh::{half_area, Node};
 use crate::accel::{Arena, BuildError};
 use crate::scalar::Scalar;
@@ -9,8 +9,8 @@ use crate::scalar::Scalar;
 /// A node still to be filled: `child[0]` is its BVH2 source (an inner node), `count[0]` its
 /// depth. Nodes are filled in index order, and a node's children get indices above every
 /// node allocated before them, so the queue is the arena itself.
-fn pending<S: Scalar>(source: u32, depth: u32) -> Node4<S> {
-    let mut n = Node4::EMPTY;
+fn pending<S: Scalar, const W: usize>(source: u32, depth: u32) -> WideNode<S, W> {
+    let mut n = WideNode::EMPTY;
     n.child[0] = source;
     n.count[0] = depth;
     n
@@ -20,11 +20,14 @@ fn pending<S: Scalar>(source: u32, depth: u32) -> Node4<S> {
 /// its two children and open the inner child with the largest surface area (the first of
 /// equals) until there are four or no inner one is left. Opening replaces a child by its two
 /// children in place, so children stay in the BVH2's depth-first (leaf-range) order.
-/// Returns the children and their number (2..=4).
-fn open<S: Scalar>(src: &[Node<S>], parent: &Node<S>) -> ([u32; 4], usize) {
-    let mut kids = [parent.first, parent.first.wrapping_add(1), 0, 0];
+/// Returns the children and their number (`2..=W`).
+fn open<S: Scalar, const W: usize>(src: &[Node<S>], parent: &Node<S>) -> ([u32; W], usize) {
+    let mut kids = [0; W];
+    if let [a, b, ..] = kids.as_mut_slice() {
+        (*a, *b) = (parent.first, parent.first.wrapping_add(1));
+    }
     let mut k = 2usize;
-    while k < 4 {
+    while k < W {
         let mut pick: Option<(usize, f32)> = None;
         for (j, &c) in kids.iter().enumerate().take(k) {
             if let Some(n) = src.get(c as usize) {
@@ -47,15 +50,15 @@ fn open<S: Scalar>(src: &[Node<S>], parent: &Node<S>) -> ([u32; 4], usize) {
             break;
         };
         // kids[j + 1..k] move one slot right; kids[j], kids[j + 1] become the two children.
-        // (Indices are below 4 here: j < k <= 3; the masks only show the compiler, as
+        // (Indices are below W here: j < k <= W - 1; the `% W` only shows the compiler, as
         // `rotate_right` kept a panic path for an empty slice.)
         let mut m = k;
         while m > j + 1 {
-            kids[m & 3] = kids[(m - 1) & 3];
+            kids[m % W] = kids[(m - 1) % W];
             m -= 1;
         }
-        kids[j & 3] = first;
-        kids[(j + 1) & 3] = first.wrapping_add(1);
+        kids[j % W] = first;
+        kids[(j + 1) % W] = first.wrapping_add(1);
         k += 1;
     }
     (kids, k)
@@ -63,12 +66,12 @@ fn open<S: Scalar>(src: &[Node<S>], parent: &Node<S>) -> ([u32; 4], usize) {
 
 /// Collapses the BVH2 `src` (root first, as [`crate::Bvh::nodes`]) into `out`. Returns the
 /// wide nodes used and the depth of the deepest one.
-pub(super) fn collapse<S: Scalar>(
+pub(super) fn collapse<S: Scalar, const W: usize>(
     src: &[Node<S>],
-    out: &mut [Node4<S>],
+    out: &mut [WideNode<S, W>],
     prim_count: usize,
 ) -> Result<(usize, u32), BuildError> {
-    let needed = nodes4_needed(prim_count).max(usize::from(!src.is_empty()));
+    let needed = wide_nodes_needed(prim_count, W).max(usize::from(!src.is_empty()));
     let too_small = BuildError::ArenaTooSmall {
         arena: Arena::Nodes,
         needed,
@@ -85,9 +88,9 @@ pub(super) fn collapse<S: Scalar>(
     };
     if root.is_leaf() {
         // A tree over one leaf: a root with one leaf child.
-        let mut n = Node4::EMPTY;
+        let mut n = WideNode::EMPTY;
         n.set(0, &root.bounds(), root.first(), root.count());
-        for i in 1..4 {
+        for i in 1..W {
             n.clear(i);
         }
         *first = n;
@@ -101,12 +104,12 @@ pub(super) fn collapse<S: Scalar>(
         };
         let (source, depth) = (queued.child[0], queued.count[0]);
         deepest = deepest.max(depth);
-        let mut node = Node4::EMPTY;
+        let mut node = WideNode::EMPTY;
         // Every BVH2 index below is in range for a tree `Bvh::build` made; a missing node
         // would only leave its slot unused.
         let (kids, k) = match src.get(source as usize) {
             Some(parent) => open(src, parent),
-            None => ([0; 4], 0),
+            None => ([0; W], 0),
         };
         for (slot, &kid) in kids.iter().enumerate() {
             let child = src.get(kid as usize).filter(|_| slot < k);

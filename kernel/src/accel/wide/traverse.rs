@@ -1,7 +1,8 @@
 //! Stack-based traversal of the 4-wide tree, nearest child first. One routine serves closest
-//! hit and any hit.
+//! hit and any hit. The query API of every wide tree is here too; `traverse8.rs` walks the
+//! 8-wide one.
 
-use super::Bvh4;
+use super::{Bvh4, WideBvh};
 use crate::accel::bvh::{test_leaf, LeafPrims, MAX_DEPTH};
 use crate::accel::{Accel, Counters, Nearest};
 use crate::geom::{Barycentrics, Primitive, Ray};
@@ -53,11 +54,17 @@ fn sort_nearest_first<S: Scalar>(e: &mut [Entry<S>; 4], n: usize) {
     }
 }
 
-impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
+/// A wide tree's walk, written per width.
+pub(super) trait Walk<S: Scalar> {
     /// Walks the tree. With `ANY`, returns at the first hit in range; otherwise finds the
     /// closest under [`closer`]. Returns (t, prim id, index into `prims`) of the hit;
-    /// `prim id == u32::MAX` for none. Runs the copy of [`Bvh4::walk`] that
-    /// [`crate::cpu`] selects.
+    /// `prim id == u32::MAX` for none.
+    fn traverse<const ANY: bool, C: Counters>(&self, ray: &Ray<S>, stats: &mut C)
+        -> (S, u32, usize);
+}
+
+impl<S: Scalar, P: Primitive<S>> Walk<S> for Bvh4<'_, S, P> {
+    /// Runs the copy of [`Bvh4::walk`] that [`crate::cpu`] selects.
     #[inline(always)]
     fn traverse<const ANY: bool, C: Counters>(
         &self,
@@ -72,7 +79,9 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
         }
         self.walk_baseline::<ANY, C>(ray, stats)
     }
+}
 
+impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
     /// [`Bvh4::walk`] as compiled for the target.
     #[inline(never)]
     fn walk_baseline<const ANY: bool, C: Counters>(
@@ -200,15 +209,20 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
         }
         best
     }
+}
 
+impl<S: Scalar, P: Primitive<S>, const W: usize> WideBvh<'_, S, P, W> {
     /// What [`test_leaf`] reads (see `Bvh::leaf`).
     #[inline(always)]
-    fn leaf(&self) -> LeafPrims<'_, P> {
+    pub(super) fn leaf(&self) -> LeafPrims<'_, P> {
         (self.prim_ids, self.prims, self.leaf_order)
     }
 }
 
-impl<S: Scalar, P: Primitive<S>> Accel<S> for Bvh4<'_, S, P> {
+impl<S: Scalar, P: Primitive<S>, const W: usize> Accel<S> for WideBvh<'_, S, P, W>
+where
+    Self: Walk<S>,
+{
     #[inline]
     fn nearest_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Nearest<S>> {
         let (t, prim, slot) = self.traverse::<false, C>(ray, stats);

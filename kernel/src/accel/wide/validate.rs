@@ -1,18 +1,36 @@
 //! Structural checker for a collapsed tree, called by tests after every collapse.
 
 use super::node::{ChildSlot, EMPTY_SLOT};
-use super::Bvh4;
+use super::{Bvh4, Bvh8, WideBvh};
 use crate::accel::bvh::{
     check_permutation, leaf_bounds, InvalidTree, TreeStats, MAX_DEPTH, MAX_LEAF_SIZE,
 };
 use crate::geom::Primitive;
 use crate::scalar::Scalar;
 
-/// Depth-first work list capacity: `3·MAX_DEPTH` pending children (the traversal bound, see
-/// `traverse.rs`) plus the 4 a node pushes.
-const STACK: usize = 3 * MAX_DEPTH + 4;
-
 impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
+    /// [`WideBvh::check`], with room for `3·MAX_DEPTH` pending children (the traversal bound,
+    /// see `traverse.rs`) plus the 4 a node pushes.
+    ///
+    /// # Errors
+    /// The first violation found.
+    pub fn validate(&self) -> Result<TreeStats, InvalidTree> {
+        self.check::<{ 3 * MAX_DEPTH + 4 }>()
+    }
+}
+
+impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
+    /// [`WideBvh::check`], with room for `7·MAX_DEPTH` pending children (the traversal bound,
+    /// see `traverse8.rs`) plus the 8 a node pushes.
+    ///
+    /// # Errors
+    /// The first violation found.
+    pub fn validate(&self) -> Result<TreeStats, InvalidTree> {
+        self.check::<{ 7 * MAX_DEPTH + 8 }>()
+    }
+}
+
+impl<S: Scalar, P: Primitive<S>, const W: usize> WideBvh<'_, S, P, W> {
     /// Checks every invariant: used slots first and at least two per node (one only for a
     /// root over a single leaf), inner children after their parent and inside its slot box,
     /// every node reached exactly once, leaves tiling the id slice in depth-first order, every
@@ -20,9 +38,11 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
     /// traversal margin (as [`crate::Bvh::validate`] checks), wide depth below [`MAX_DEPTH`] and as
     /// recorded. `TreeStats::depth` is the depth of the deepest wide node.
     ///
+    /// `STACK` bounds the depth-first work list.
+    ///
     /// # Errors
     /// The first violation found.
-    pub fn validate(&self) -> Result<TreeStats, InvalidTree> {
+    fn check<const STACK: usize>(&self) -> Result<TreeStats, InvalidTree> {
         let n = self.prims.len();
         let mut stats = TreeStats {
             node_count: self.nodes.len(),

@@ -1,0 +1,188 @@
+//! Stack-based traversal of the 8-wide tree, nearest child first. One routine serves closest
+//! hit and any hit. The eight boxes of a node are tested in two 4-lane halves
+//! (`Numerics::slab8`), or in the 256-bit lanes of one AVX vector (`Numerics::slab8_avx`)
+//! where the CPU has it: the same bits either way.
+
+use super::traverse::Walk;
+use super::Bvh8;
+use crate::accel::bvh::{test_leaf, MAX_DEPTH};
+use crate::accel::Counters;
+use crate::geom::{Primitive, Ray};
+use crate::scalar::Scalar;
+
+/// Traversal stack capacity.
+///
+/// Bound: as for the 4-wide tree (`traverse.rs`), wide nodes sit at depths
+/// `0..=MAX_DEPTH - 1`, and visiting one pushes its hit children but the nearest: at most 7.
+/// So the stack holds at most `7·d` entries on entering a node at depth `d`, and at most
+/// `7·d + 7 <= 7·MAX_DEPTH` after it has pushed.
+const STACK: usize = 7 * MAX_DEPTH;
+
+/// A child to visit: `(child, count)` as in a [`super::Node8`]'s slots, and its entry distance.
+type Entry<S> = (u32, u32, S);
+
+impl<S: Scalar, P: Primitive<S>> Walk<S> for Bvh8<'_, S, P> {
+    /// Runs the copy of [`Bvh8::walk8`] that [`crate::cpu`] selects.
+    #[inline(always)]
+    fn traverse<const ANY: bool, C: Counters>(
+        &self,
+        ray: &Ray<S>,
+        stats: &mut C,
+    ) -> (S, u32, usize) {
+        #[cfg(all(target_arch = "x86_64", not(target_feature = "avx2")))]
+        if crate::cpu::avx2() {
+            #[allow(unsafe_code)]
+            // SAFETY: `cpu::avx2` is true only on a CPU with every feature `walk8_avx2` enables.
+            return unsafe { self.walk8_avx2::<ANY, C>(ray, stats) };
+        }
+        self.walk8_baseline::<ANY, C>(ray, stats)
+    }
+}
+
+impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
+    /// [`Bvh8::walk8`] as compiled for the target (in 256-bit lanes if the target has AVX).
+    #[inline(never)]
+    fn walk8_baseline<const ANY: bool, C: Counters>(
+        &self,
+        ray: &Ray<S>,
+        stats: &mut C,
+    ) -> (S, u32, usize) {
+        self.walk8::<ANY, C, { cfg!(all(target_arch = "x86_64", target_feature = "avx")) }>(
+            ray, stats,
+        )
+    }
+
+    /// [`Bvh8::walk8`] compiled for AVX2, its box tests in 256-bit lanes (see [`crate::cpu`]).
+    ///
+    /// # Safety
+    /// The CPU must have every feature enabled here (`cpu::avx2` checks).
+    #[cfg(all(target_arch = "x86_64", not(target_feature = "avx2")))]
+    #[allow(unsafe_code)]
+    #[target_feature(enable = "avx,avx2,bmi1,bmi2,lzcnt,popcnt")]
+    unsafe fn walk8_avx2<const ANY: bool, C: Counters>(
+        &self,
+        ray: &Ray<S>,
+        stats: &mut C,
+    ) -> (S, u32, usize) {
+        self.walk8::<ANY, C, true>(ray, stats)
+    }
+
+    /// The traversal itself, inlined into each compiled copy. `AVX`: test the boxes with
+    /// `Numerics::slab8_avx`; set only in copies that run on a CPU with AVX.
+    #[inline(always)]
+    fn walk8<const ANY: bool, C: Counters, const AVX: bool>(
+        &self,
+        ray: &Ray<S>,
+        stats: &mut C,
+    ) -> (S, u32, usize) {
+        let rd = ray.data();
+        let t_min = ray.t_min();
+        // (t, prim id, index into `prims`) of the best hit so far.
+        let mut best = (ray.t_max(), u32::MAX, 0usize);
+        if self.nodes.is_empty() {
+            return best;
+        }
+        // Cannot overflow (see `STACK`); a failed push would only skip a child.
+        let mut stack: heapless::Vec<Entry<S>, STACK> = heapless::Vec::new();
+        // The root's own box is not stored: its children's boxes are tested instead.
+        let (mut child, mut count) = (0u32, 0u32);
+        'walk: loop {
+            if count == 0 {
+                if let Some(node) = self.nodes.get(child as usize) {
+                    let used = node.used_mask();
+                    for _ in 0..used.count_ones() {
+                        stats.node();
+                    }
+                    #[cfg(target_arch = "x86_64")]
+                    let (hit, t) = if AVX {
+                        #[allow(unsafe_code)]
+                        // SAFETY: `AVX` is set only in copies that run on a CPU with AVX.
+                        unsafe {
+                            S::slab8_avx(rd, &node.lo, &node.hi, t_min, best.0)
+                        }
+                    } else {
+                        S::slab8(rd, &node.lo, &node.hi, t_min, best.0)
+                    };
+                    #[cfg(not(target_arch = "x86_64"))]
+                    let (hit, t) = S::slab8(rd, &node.lo, &node.hi, t_min, best.0);
+                    let hit = hit & used;
+                    let slot = |i: u32| {
+                        let i = i as usize % 8;
+                        (node.child[i], node.count[i], t[i])
+                    };
+                    // None hit: fall through to the pop below.
+                    if hit != 0 {
+                        let first = slot(hit.trailing_zeros());
+                        let others = hit & (hit - 1);
+                        if others == 0 {
+                            // One child hit (the common case deep in the tree): go there.
+                            let i = match hit {
+                                1 => 0,
+                                2 => 1,
+                                4 => 2,
+                                8 => 3,
+                                16 => 4,
+                                32 => 5,
+                                64 => 6,
+                                _ => 7,
+                            };
+                            (child, count) = (node.child[i], node.count[i]);
+                            continue 'walk;
+                        }
+                        if others & (others - 1) == 0 {
+                            // Two: visit the nearer (the first on a tie), push the other.
+                            let second = slot(others.trailing_zeros());
+                            let (near, far) = if second.2 < first.2 {
+                                (second, first)
+                            } else {
+                                (first, second)
+                            };
+                            let _ = stack.push(far);
+                            (child, count) = (near.0, near.1);
+                            continue 'walk;
+                        }
+                        // Three or more: insertion into nearest-first order (the first of
+                        // equals first), then the farthest pushed first.
+                        let mut e: [Entry<S>; 8] = [(0, 0, t_min); 8];
+                        let mut n = 0usize;
+                        let mut rest = hit;
+                        while rest != 0 {
+                            let x = slot(rest.trailing_zeros());
+                            rest &= rest - 1;
+                            let mut m = n;
+                            while m > 0 && x.2 < e[(m - 1) % 8].2 {
+                                e[m % 8] = e[(m - 1) % 8];
+                                m -= 1;
+                            }
+                            e[m % 8] = x;
+                            n += 1;
+                        }
+                        if let Some((&(c, k, _), rest)) = e.get(..n).and_then(<[_]>::split_first) {
+                            for &far in rest.iter().rev() {
+                                let _ = stack.push(far);
+                            }
+                            (child, count) = (c, k);
+                            continue 'walk;
+                        }
+                    }
+                }
+            } else {
+                let leaf = (child as usize, count as usize);
+                if test_leaf(self.leaf(), leaf, rd, t_min, &mut best, stats, ANY) {
+                    return best;
+                }
+            }
+            // Pop the next child still in reach of the current best.
+            loop {
+                let Some((c, k, t_near)) = stack.pop() else {
+                    break 'walk;
+                };
+                if t_near <= S::widen(best.0) {
+                    (child, count) = (c, k);
+                    continue 'walk;
+                }
+            }
+        }
+        best
+    }
+}
