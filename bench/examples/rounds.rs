@@ -1,7 +1,8 @@
-//! The interleaved rounds alone, for quick A/B work on the headline structure: per ray set,
-//! ray construction on its own (ns per ray) and the rounds of `raykernel_bench::rounds` (ours
-//! per ray, Embree HIGH with the `embree` feature, ours on pre-built rays, tinybvh with the
-//! `tinybvh` feature), with the per-round ratio against Embree. Seconds per scene instead of
+//! The interleaved rounds alone, for quick A/B work on the headline structures: per ray set,
+//! ray construction on its own (ns per ray) and the rounds of `raykernel_bench::rounds` (ours,
+//! the 4-wide and the 8-wide BVH, per ray, Embree HIGH with the `embree` feature, ours on
+//! pre-built rays, tinybvh with the `tinybvh` feature), with the per-round ratios against
+//! Embree. Seconds per scene instead of
 //! the full benchmark's quarter hour; the full run stays the one that writes the report.
 //! `--simd-ab` compares the traversal's two compiled copies instead (`raykernel::cpu`).
 //!
@@ -44,9 +45,9 @@ struct Args {
     simd_ab: bool,
 }
 
-/// Per round, the headline structure traced with the baseline copy of the traversal and then
+/// Per round, the headline structures traced with the baseline copy of the traversal and then
 /// with the AVX2 copy; prints the per-round ratios (per ray, and their median on pre-built
-/// rays). Leaves the copy the CPU supports selected.
+/// rays) of each. Leaves the copy the CPU supports selected.
 fn simd_ab(scene: &BenchScene, set: &RaySet, opts: RunOptions, rounds: usize) -> Result<(), Error> {
     let available = set_traversal_simd(Simd::Avx2);
     if available != Simd::Avx2 {
@@ -57,7 +58,8 @@ fn simd_ab(scene: &BenchScene, set: &RaySet, opts: RunOptions, rounds: usize) ->
         );
         return Ok(());
     }
-    let (mut per_ray, mut prebuilt) = (Vec::new(), Vec::new());
+    let structures = rounds::STRUCTURES.len();
+    let (mut per_ray, mut prebuilt) = (vec![Vec::new(); structures], vec![Vec::new(); structures]);
     for _ in 0..rounds.max(1) {
         let once = |simd| {
             set_traversal_simd(simd);
@@ -65,18 +67,23 @@ fn simd_ab(scene: &BenchScene, set: &RaySet, opts: RunOptions, rounds: usize) ->
         };
         let (base, avx2) = (once(Simd::Baseline)?, once(Simd::Avx2)?);
         let ratio = |a: &[f64], b: &[f64]| a.first().zip(b.first()).map_or(0.0, |(a, b)| a / b);
-        per_ray.push(ratio(&avx2.ours_mrays, &base.ours_mrays));
-        prebuilt.push(ratio(&avx2.ours_prebuilt_mrays, &base.ours_prebuilt_mrays));
+        for (i, (b, a)) in base.ours.iter().zip(&avx2.ours).enumerate() {
+            per_ray[i].push(ratio(&a.per_ray_mrays, &b.per_ray_mrays));
+            prebuilt[i].push(ratio(&a.prebuilt_mrays, &b.prebuilt_mrays));
+        }
     }
-    let listed: Vec<String> = per_ray.iter().map(|r| format!("{r:.3}")).collect();
-    println!(
-        "{:8} {:10} avx2 ÷ baseline per ray {:.3} (rounds {}), pre-built {:.3}",
-        scene.name,
-        set.kind.name(),
-        median(&per_ray),
-        listed.join(" "),
-        median(&prebuilt)
-    );
+    for (i, kind) in rounds::STRUCTURES.iter().enumerate() {
+        let listed: Vec<String> = per_ray[i].iter().map(|r| format!("{r:.3}")).collect();
+        println!(
+            "{:8} {:10} {} avx2 ÷ baseline per ray {:.3} (rounds {}), pre-built {:.3}",
+            scene.name,
+            set.kind.name(),
+            kind.name(),
+            median(&per_ray[i]),
+            listed.join(" "),
+            median(&prebuilt[i])
+        );
+    }
     Ok(())
 }
 
@@ -105,29 +112,40 @@ fn main() -> Result<(), Error> {
         }
         return Ok(());
     }
-    println!("scene    rays        setup ns  ours  pre-built  Embree  ours/Embree per round: median (min-max)");
+    println!(
+        "scene    rays       structure  setup ns  ours  pre-built  Embree  ours/Embree per round: median (min-max)"
+    );
     for scene in &scenes {
         for set in &scene.ray_sets {
             let setup = construction_ns(set, stride, args.rounds);
             let opts = RunOptions { stride, runs: 1 };
             let row = rounds::run(scene, set, opts, args.rounds, true)?;
-            let ours = median(&row.ours_mrays);
-            let prebuilt = median(&row.ours_prebuilt_mrays);
-            let versus = row
-                .vs_embree()
-                .map_or("no Embree in this build".to_string(), |p| {
-                    let (lo, hi) = p.ratio_range();
-                    format!(
-                        "{:5.2}  {:.3} ({lo:.3}-{hi:.3})",
-                        p.peer_median,
-                        p.median_ratio()
-                    )
-                });
-            println!(
-                "{:8} {:10} {setup:9.1}  {ours:4.2}  {prebuilt:9.2}  {versus}",
-                scene.name,
-                set.kind.name()
-            );
+            let fastest = row.fastest().map(|o| o.structure);
+            for ours in &row.ours {
+                let per_ray = median(&ours.per_ray_mrays);
+                let prebuilt = median(&ours.prebuilt_mrays);
+                let versus =
+                    row.vs_embree(ours)
+                        .map_or("no Embree in this build".to_string(), |p| {
+                            let (lo, hi) = p.ratio_range();
+                            format!(
+                                "{:5.2}  {:.3} ({lo:.3}-{hi:.3})",
+                                p.peer_median,
+                                p.median_ratio()
+                            )
+                        });
+                let mark = if fastest == Some(ours.structure) {
+                    "*"
+                } else {
+                    " "
+                };
+                println!(
+                    "{:8} {:10} {:5}{mark}    {setup:8.1}  {per_ray:4.2}  {prebuilt:9.2}  {versus}",
+                    scene.name,
+                    set.kind.name(),
+                    ours.structure,
+                );
+            }
         }
     }
     Ok(())

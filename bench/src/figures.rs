@@ -61,24 +61,29 @@ pub fn figures(r: &BenchResults) -> Vec<Figure> {
         }
     }
     for x in &r.rounds {
-        let series = [
-            ("raykernel bvh4 sah f32", "closest_mrays", &x.ours_mrays),
+        let ours = x.ours.iter().flat_map(|o| {
+            let contender = format!("raykernel {} sah f32", o.structure);
+            [
+                (contender.clone(), "closest_mrays", &o.per_ray_mrays),
+                (contender, "closest_mrays_prebuilt", &o.prebuilt_mrays),
+            ]
+        });
+        let peers = [
             (
-                "raykernel bvh4 sah f32",
-                "closest_mrays_prebuilt",
-                &x.ours_prebuilt_mrays,
+                "Embree 3 HIGH".to_string(),
+                "closest_mrays",
+                &x.embree_mrays,
             ),
-            ("Embree 3 HIGH", "closest_mrays", &x.embree_mrays),
             (
-                "tinybvh 1.6 BVH2",
+                "tinybvh 1.6 BVH2".to_string(),
                 "closest_mrays_prebuilt",
                 &x.tinybvh_mrays,
             ),
         ];
-        for (contender, figure, values) in series {
+        for (contender, figure, values) in ours.chain(peers) {
             for (k, v) in values.iter().enumerate() {
                 let name = format!("{figure}_{}{}", names::ROUND_PREFIX, k + 1);
-                push(&x.scene, x.rays.name(), contender, &name, *v);
+                push(&x.scene, x.rays.name(), &contender, &name, *v);
             }
         }
     }

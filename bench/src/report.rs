@@ -342,24 +342,40 @@ fn file_name(path: &Path) -> String {
 }
 
 /// The reference row of a ray set: ours, `f32`, watertight, default builder.
+/// The headline structures: the wide BVHs collapsed from the SAH BVH.
+const HEADLINE_STRUCTURES: [&str; 2] = ["bvh4", "bvh8"];
+
+/// Ours in the headline: of the wide BVHs from the SAH build, `f32` and watertight, the one
+/// fastest per ray (construction counted) on this ray set.
 fn our_reference<'r>(rows: &'r [TraceRow], scene: &str, kind: RayKind) -> Option<&'r TraceRow> {
-    rows.iter().find(|r| {
-        r.ours
-            && r.scene == scene
-            && r.rays == kind
-            && r.mode == "f32"
-            && r.test == "watertight"
-            && r.builder == raykernel::bvh::BuilderKind::default().name()
-    })
+    rows.iter()
+        .filter(|r| {
+            r.ours
+                && r.scene == scene
+                && r.rays == kind
+                && r.mode == "f32"
+                && r.test == "watertight"
+                && r.builder == raykernel::bvh::BuilderKind::default().name()
+                && HEADLINE_STRUCTURES.contains(&r.contender.as_str())
+        })
+        .reduce(|a, b| {
+            if b.closest_mrays > a.closest_mrays {
+                b
+            } else {
+                a
+            }
+        })
 }
 
-fn fixed_reference<'r>(rows: &'r [TraceRow], scene: &str, kind: RayKind) -> Option<&'r TraceRow> {
+/// The same structure as `reference`, in fixed point.
+fn fixed_reference<'r>(rows: &'r [TraceRow], reference: &TraceRow) -> Option<&'r TraceRow> {
     rows.iter().find(|r| {
         r.ours
-            && r.scene == scene
-            && r.rays == kind
+            && r.scene == reference.scene
+            && r.rays == reference.rays
             && r.mode == "fixed"
-            && r.builder == raykernel::bvh::BuilderKind::default().name()
+            && r.contender == reference.contender
+            && r.builder == reference.builder
     })
 }
 
@@ -465,16 +481,17 @@ fn headline_section(s: &mut String, r: &BenchResults) {
          as a caller fills Embree's ray structure), and Embree's \
          `rtcIntersect1` takes the raw record; the other peers take rays converted ahead, so \
          their conversion time is added to their trace time. `pre-built` is raykernel tracing \
-         rays constructed ahead (traversal alone). Ours is raykernel `f32`, the 4-wide BVH \
-         collapsed from the SAH BVH with the triangles permuted into leaf order \
-         (`build_in_leaf_order`, in place), watertight; ratios are ours per ray ÷ peer: above \
+         rays constructed ahead (traversal alone). Ours is raykernel `f32`, watertight, with \
+         the faster per ray on the ray set (`structure`) of the 4-wide and the 8-wide BVH, \
+         both collapsed from the SAH BVH with the triangles permuted into leaf order \
+         (`build_in_leaf_order`, in place); ratios are ours per ray ÷ peer: above \
          1 means ours is faster. `fixed ÷ f32` is the same structure in fixed point per ray, ray \
          construction included, against `f32`.\n"
     );
     let mut head =
-        "| scene | triangles | rays | raykernel f32 | raykernel f32 pre-built | raykernel fixed | fixed ÷ f32 |"
+        "| scene | triangles | rays | structure | raykernel f32 | raykernel f32 pre-built | raykernel fixed | fixed ÷ f32 |"
             .to_string();
-    let mut rule = "|---|---:|---|---:|---:|---:|---:|".to_string();
+    let mut rule = "|---|---:|---|---|---:|---:|---:|---:|".to_string();
     for p in &peers {
         let _ = write!(head, " {p} | ratio |");
         rule.push_str("---:|---:|");
@@ -485,11 +502,12 @@ fn headline_section(s: &mut String, r: &BenchResults) {
             let Some(ours) = our_reference(&r.rows, &scene, kind) else {
                 continue;
             };
-            let fixed = fixed_reference(&r.rows, &scene, kind);
+            let fixed = fixed_reference(&r.rows, ours);
             let mut line = format!(
-                "| {scene} | {} | {} | {:.2} | {} | {} | {} |",
+                "| {scene} | {} | {} | {} | {:.2} | {} | {} | {} |",
                 ours.triangles,
                 kind.name(),
+                ours.contender,
                 ours.closest_mrays,
                 opt(ours.closest_mrays_prebuilt, 2),
                 fixed.map_or("-".into(), |f| format!("{:.2}", f.closest_mrays)),
@@ -591,7 +609,7 @@ fn construction_table(s: &mut String, r: &BenchResults) {
             let Some(ours) = our_reference(&r.rows, &scene, kind) else {
                 continue;
             };
-            let fixed = fixed_reference(&r.rows, &scene, kind);
+            let fixed = fixed_reference(&r.rows, ours);
             let _ = writeln!(
                 s,
                 "| {scene} | {} | {:.1} | {} |",
@@ -620,17 +638,18 @@ fn rounds_section(s: &mut String, r: &BenchResults) {
     let _ = writeln!(
         s,
         "### Interleaved rounds\n\n\
-         Each ray set traced {} times in alternation: raykernel `f32` (4-wide BVH, SAH, leaf \
-         order) per ray, Embree 3 HIGH, raykernel on pre-built rays, tinybvh 1.6's BVH2 on pre-built \
-         rays; each structure built once. A slow spell of the machine then slows every \
-         contender of a round, so the per-round ratio is the robust comparison: ours per ray ÷ \
-         Embree (both pay their ray setup), ours pre-built ÷ tinybvh (neither does). `best` is \
-         the fastest round: noise from other tenants only adds time, so it is the figure least \
-         disturbed by them (Chen and Revels 2016). Embree's AVX kernels return with the upper \
-         halves of the vector registers in use, which slows the SSE code timed after them \
-         until something clears them: the harness clears them (`vzeroupper`) after every \
-         Embree call, outside its timing.{}\n",
-        first.ours_mrays.len(),
+         Each ray set traced {} times in alternation: raykernel `f32` (the 4-wide and the \
+         8-wide BVH, SAH, leaf order) per ray, Embree 3 HIGH, raykernel on pre-built rays, \
+         tinybvh 1.6's BVH2 on pre-built rays; each structure built once. A slow spell of the \
+         machine then slows every contender of a round, so the per-round ratio is the robust \
+         comparison: ours per ray ÷ Embree (both pay their ray setup), ours pre-built ÷ tinybvh \
+         (neither does). `fastest` marks the structure faster per ray on the set (by median): \
+         the headline. `best` is the fastest round: noise from other tenants only adds time, \
+         so it is the figure least disturbed by them (Chen and Revels 2016). Embree's AVX \
+         kernels return with the upper halves of the vector registers in use, which slows the \
+         SSE code timed after them until something clears them: the harness clears them \
+         (`vzeroupper`) after every Embree call, outside its timing.{}\n",
+        first.ours.first().map_or(0, |o| o.per_ray_mrays.len()),
         if missing.is_empty() {
             String::new()
         } else {
@@ -643,36 +662,46 @@ fn rounds_section(s: &mut String, r: &BenchResults) {
          |---|---|---|---:|---:|---:|---:|---:|"
     );
     for x in &r.rounds {
-        let pairs = [
-            ("per ray ÷ Embree 3 HIGH", x.vs_embree()),
-            ("pre-built ÷ tinybvh BVH2", x.vs_tinybvh()),
-        ];
-        let mut any = false;
-        for (name, pairing) in pairs {
-            let Some(p) = pairing else { continue };
-            any = true;
-            let (lo, hi) = p.ratio_range();
-            let _ = writeln!(
-                s,
-                "| {} | {} | {name} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2}× ({lo:.2}–{hi:.2}) |",
-                x.scene,
-                x.rays.name(),
-                p.ours_median,
-                p.ours_best,
-                p.peer_median,
-                p.peer_best,
-                p.median_ratio(),
-            );
-        }
-        if !any {
-            let _ = writeln!(
-                s,
-                "| {} | {} | ours alone | {:.2} | {:.2} | - | - | - |",
-                x.scene,
-                x.rays.name(),
-                host::trace::median(&x.ours_mrays),
-                x.ours_mrays.iter().copied().fold(0.0, f64::max),
-            );
+        let fastest = x.fastest().map(|o| o.structure);
+        for ours in &x.ours {
+            let mark = if fastest == Some(ours.structure) {
+                " (fastest)"
+            } else {
+                ""
+            };
+            let pairs = [
+                ("per ray ÷ Embree 3 HIGH", x.vs_embree(ours)),
+                ("pre-built ÷ tinybvh BVH2", x.vs_tinybvh(ours)),
+            ];
+            let mut any = false;
+            for (name, pairing) in pairs {
+                let Some(p) = pairing else { continue };
+                any = true;
+                let (lo, hi) = p.ratio_range();
+                let _ = writeln!(
+                    s,
+                    "| {} | {} | {}{mark} {name} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2}× ({lo:.2}–{hi:.2}) |",
+                    x.scene,
+                    x.rays.name(),
+                    ours.structure,
+                    p.ours_median,
+                    p.ours_best,
+                    p.peer_median,
+                    p.peer_best,
+                    p.median_ratio(),
+                );
+            }
+            if !any {
+                let _ = writeln!(
+                    s,
+                    "| {} | {} | {}{mark} alone | {:.2} | {:.2} | - | - | - |",
+                    x.scene,
+                    x.rays.name(),
+                    ours.structure,
+                    host::trace::median(&ours.per_ray_mrays),
+                    ours.per_ray_mrays.iter().copied().fold(0.0, f64::max),
+                );
+            }
         }
     }
     let _ = writeln!(s);

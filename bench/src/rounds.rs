@@ -1,10 +1,11 @@
-//! Interleaved rounds: the headline contender (the 4-wide BVH collapsed from the SAH BVH,
-//! `f32`) and the peers it is compared with trace one ray set in alternation, round after
-//! round: ours per ray (each ray constructed from its record in the timed loop), Embree HIGH
-//! (`rtcIntersect1` on the raw records, with the `embree` feature), ours on pre-built rays,
-//! tinybvh's BVH2 on pre-built rays (with the `tinybvh` feature); then again. Each structure
-//! is built once; only tracing is timed. The per-round ratios pair like with like: ours per
-//! ray ÷ Embree (both pay their ray setup), ours pre-built ÷ tinybvh (neither does).
+//! Interleaved rounds: the headline contenders (the 4-wide and the 8-wide BVH collapsed from
+//! the SAH BVH, `f32`, leaf order) and the peers they are compared with trace one ray set in
+//! alternation, round after round: ours per ray (each ray constructed from its record in the
+//! timed loop), Embree HIGH (`rtcIntersect1` on the raw records, with the `embree` feature),
+//! ours on pre-built rays, tinybvh's BVH2 on pre-built rays (with the `tinybvh` feature); then
+//! again. Each structure is built once; only tracing is timed. The per-round ratios pair like
+//! with like: ours per ray ÷ Embree (both pay their ray setup), ours pre-built ÷ tinybvh
+//! (neither does).
 //!
 //! Why: on a shared VM a slow spell (another tenant's memory traffic) can last seconds to
 //! minutes, long enough to cover one contender's consecutive runs and not the other's. In
@@ -21,8 +22,26 @@ use host::trace::{
     build_and_visit, median, prepare_rays, trace_closest, trace_closest_per_ray, AccelConfig,
     NodeArena, PreparedRays,
 };
-use raykernel::{Accel, AccelKind, AccelVisitor};
+use raykernel::bvh::BuildOptions;
+use raykernel::{Accel, AccelKind, AccelVisitor, Triangle};
 use serde::Serialize;
+
+/// The structures of the rounds, in this order: the wide BVHs from the SAH build.
+pub const STRUCTURES: [AccelKind; 2] = [
+    AccelKind::Bvh4(BuildOptions::DEFAULT),
+    AccelKind::Bvh8(BuildOptions::DEFAULT),
+];
+
+/// One of ours in the rounds: Mrays/s in each round.
+#[derive(Clone, Debug, Serialize)]
+pub struct OursRounds {
+    /// The structure's name (`bvh4`, `bvh8`).
+    pub structure: &'static str,
+    /// Each ray constructed in the loop (closest hit).
+    pub per_ray_mrays: Vec<f64>,
+    /// On pre-built rays.
+    pub prebuilt_mrays: Vec<f64>,
+}
 
 /// One ray set's rounds: Mrays/s of each contender in each round, in round order (a
 /// contender this build lacks has no figures).
@@ -34,10 +53,8 @@ pub struct RoundsRow {
     pub rays: RayKind,
     /// Rays traced per round.
     pub ray_count: usize,
-    /// Ours (4-wide BVH, SAH, `f32`, closest hit), each ray constructed in the loop.
-    pub ours_mrays: Vec<f64>,
-    /// Ours on pre-built rays.
-    pub ours_prebuilt_mrays: Vec<f64>,
+    /// Ours, one entry per structure of [`STRUCTURES`].
+    pub ours: Vec<OursRounds>,
     /// Embree 3 HIGH, `rtcIntersect1` on the raw records.
     pub embree_mrays: Vec<f64>,
     /// tinybvh's BVH2 on pre-built rays.
@@ -96,16 +113,28 @@ impl Pairing {
 }
 
 impl RoundsRow {
-    /// Ours per ray against Embree HIGH (`None` without Embree).
+    /// Ours fastest per ray (by median), the headline structure of this ray set.
     #[must_use]
-    pub fn vs_embree(&self) -> Option<Pairing> {
-        Pairing::of(&self.ours_mrays, &self.embree_mrays)
+    pub fn fastest(&self) -> Option<&OursRounds> {
+        self.ours.iter().reduce(|a, b| {
+            if median(&b.per_ray_mrays) > median(&a.per_ray_mrays) {
+                b
+            } else {
+                a
+            }
+        })
     }
 
-    /// Ours pre-built against tinybvh (`None` without tinybvh).
+    /// `ours` per ray against Embree HIGH (`None` without Embree).
     #[must_use]
-    pub fn vs_tinybvh(&self) -> Option<Pairing> {
-        Pairing::of(&self.ours_prebuilt_mrays, &self.tinybvh_mrays)
+    pub fn vs_embree(&self, ours: &OursRounds) -> Option<Pairing> {
+        Pairing::of(&ours.per_ray_mrays, &self.embree_mrays)
+    }
+
+    /// `ours` pre-built against tinybvh (`None` without tinybvh).
+    #[must_use]
+    pub fn vs_tinybvh(&self, ours: &OursRounds) -> Option<Pairing> {
+        Pairing::of(&ours.prebuilt_mrays, &self.tinybvh_mrays)
     }
 }
 
@@ -114,10 +143,8 @@ fn best(xs: &[f64]) -> f64 {
     xs.iter().copied().fold(0.0, f64::max)
 }
 
-/// The headline configuration: 4-wide BVH, default (SAH) build, primitives in leaf order.
-#[must_use]
-pub fn headline_config() -> AccelConfig {
-    let accel = AccelKind::Bvh4(raykernel::bvh::BuildOptions::default());
+/// A structure of [`STRUCTURES`] as built for the rounds: primitives in leaf order.
+fn config(accel: AccelKind) -> AccelConfig {
     AccelConfig {
         accel,
         leaf_order: accel.permutes_into_leaf_order(),
@@ -138,9 +165,10 @@ pub fn run(
 ) -> Result<RoundsRow, Error> {
     let tris = scene.mesh.kernel_triangles::<f32>(&scene.path)?;
     let prepared = prepare_rays::<f32>(&set.records, opts.stride);
-    let config = headline_config();
-    let mut arena = NodeArena::<f32>::for_accel(config.accel, &tris);
-    let visitor = Alternate {
+    let [first, second] = STRUCTURES.map(config);
+    let mut arena = NodeArena::<f32>::for_accel(first.accel, &tris);
+    let mut second_arena = NodeArena::<f32>::for_accel(second.accel, &tris);
+    let rounds_of = Alternate {
         scene,
         records: &set.records,
         prepared: &prepared,
@@ -148,19 +176,73 @@ pub fn run(
         rounds: rounds.max(1),
         with_peers,
     };
-    let (_, figures) = build_and_visit(&tris, &mut arena, &scene.path, &config, visitor)?;
+    let builds_second = BuildSecond {
+        tris: &tris,
+        arena: &mut second_arena,
+        scene,
+        config: second,
+        rounds_of,
+    };
+    let (_, figures) = build_and_visit(&tris, &mut arena, &scene.path, &first, builds_second)?;
+    let figures = figures?;
+    let ours = STRUCTURES
+        .iter()
+        .zip(figures.per_ray)
+        .zip(figures.prebuilt)
+        .map(|((kind, per_ray_mrays), prebuilt_mrays)| OursRounds {
+            structure: kind.name(),
+            per_ray_mrays,
+            prebuilt_mrays,
+        })
+        .collect();
     Ok(RoundsRow {
         scene: scene.name.clone(),
         rays: set.kind,
         ray_count: prepared.rays.len(),
-        ours_mrays: figures.ours,
-        ours_prebuilt_mrays: figures.ours_prebuilt,
+        ours,
         embree_mrays: figures.embree,
         tinybvh_mrays: figures.tinybvh,
     })
 }
 
-/// Visits the built headline structure: the rounds themselves.
+/// Visits the first built structure: builds the second and visits both ([`Both`]).
+struct BuildSecond<'p, 'a> {
+    tris: &'p [Triangle<f32>],
+    arena: &'a mut NodeArena<f32>,
+    scene: &'p BenchScene,
+    config: AccelConfig,
+    rounds_of: Alternate<'p>,
+}
+
+impl AccelVisitor<f32> for BuildSecond<'_, '_> {
+    type Output = Result<Figures, Error>;
+
+    fn visit<A: Accel<f32>>(self, first: &A) -> Self::Output {
+        let both = Both {
+            first,
+            rounds_of: self.rounds_of,
+        };
+        build_and_visit(self.tris, self.arena, &self.scene.path, &self.config, both)
+            .map(|(_, figures)| figures)
+            .map_err(Error::from)
+    }
+}
+
+/// Visits the second built structure, with the first at hand: the rounds themselves.
+struct Both<'p, 'f, A> {
+    first: &'f A,
+    rounds_of: Alternate<'p>,
+}
+
+impl<A: Accel<f32>> AccelVisitor<f32> for Both<'_, '_, A> {
+    type Output = Figures;
+
+    fn visit<B: Accel<f32>>(self, second: &B) -> Figures {
+        self.rounds_of.run(self.first, second)
+    }
+}
+
+/// The rounds over the two built structures.
 struct Alternate<'p> {
     scene: &'p BenchScene,
     records: &'p [RayRecord],
@@ -170,30 +252,37 @@ struct Alternate<'p> {
     with_peers: bool,
 }
 
+/// Each contender's figures, round by round; ours per structure of [`STRUCTURES`].
 #[derive(Default)]
 struct Figures {
-    ours: Vec<f64>,
-    ours_prebuilt: Vec<f64>,
+    per_ray: [Vec<f64>; 2],
+    prebuilt: [Vec<f64>; 2],
     embree: Vec<f64>,
     tinybvh: Vec<f64>,
 }
 
-impl AccelVisitor<f32> for Alternate<'_> {
-    type Output = Figures;
-
-    fn visit<A: Accel<f32>>(self, accel: &A) -> Figures {
+impl Alternate<'_> {
+    fn run<A: Accel<f32>, B: Accel<f32>>(self, first: &A, second: &B) -> Figures {
         let n = self.prepared.rays.len();
         let mut figures = Figures::default();
         let inputs = EmbreeInputs::new(self.scene, self.records, self.with_peers);
         let embree = inputs.build();
         let round = |figures: &mut Figures| {
-            let per_ray = trace_closest_per_ray(accel, self.records, self.stride).1;
-            figures.ours.push(mrays(n, per_ray));
+            let [per_ray_a, per_ray_b] = &mut figures.per_ray;
+            per_ray_a.push(mrays(
+                n,
+                trace_closest_per_ray(first, self.records, self.stride).1,
+            ));
+            per_ray_b.push(mrays(
+                n,
+                trace_closest_per_ray(second, self.records, self.stride).1,
+            ));
             if let Some(e) = &embree {
                 figures.embree.push(e.trace(self.stride));
             }
-            let prebuilt = trace_closest(accel, self.prepared).1;
-            figures.ours_prebuilt.push(mrays(n, prebuilt));
+            let [prebuilt_a, prebuilt_b] = &mut figures.prebuilt;
+            prebuilt_a.push(mrays(n, trace_closest(first, self.prepared).1));
+            prebuilt_b.push(mrays(n, trace_closest(second, self.prepared).1));
         };
         let tinybvh = self.with_peers.then(|| {
             let tris: Vec<[[f32; 3]; 3]> = (0..self.scene.mesh.triangle_count())

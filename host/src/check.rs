@@ -278,6 +278,12 @@ mod tests {
                 .count(),
             6
         );
+        assert_eq!(
+            v.iter()
+                .filter(|x| matches!(x.accel, AccelKind::Bvh8(_)))
+                .count(),
+            6
+        );
         assert!(v.iter().any(|x| x.threads == 3));
         assert!(v.iter().any(|x| x.tile == (7, 5)));
     }

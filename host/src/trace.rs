@@ -8,17 +8,17 @@
 //! [`trace_closest_per_ray`] times queries that set one ray from each record in turn,
 //! [`prepare_rays`] and [`trace_closest`] the two halves of a trace of pre-built rays.
 //!
-//! [`AccelKind::Bvh4`] builds the BVH (timed) and collapses it into the 4-wide tree (timed
-//! too); the BVH's node arena is build scratch, so its figures count only the wide nodes and
-//! the primitive ids the queries read.
+//! [`AccelKind::Bvh4`] and [`AccelKind::Bvh8`] build the BVH (timed) and collapse it into the
+//! wide tree (timed too); the BVH's node arena is build scratch, so their figures count only
+//! the wide nodes and the primitive ids the queries read.
 
 use crate::error::Error;
 use crate::obj::Mesh;
 use crate::rayfile::{HitRecord, RayRecord};
 use raykernel::bvh::BuilderKind;
 use raykernel::{
-    Accel, AccelKind, AccelMemory, AccelVisitor, AnyAccel, KdNode, Node, Node4, Node8, Primitive, Ray,
-    Scalar, Triangle, I16F16,
+    Accel, AccelKind, AccelMemory, AccelVisitor, AnyAccel, KdNode, Node, Node4, Node8, Primitive,
+    Ray, Scalar, Triangle, I16F16,
 };
 use std::path::Path;
 use std::time::Instant;

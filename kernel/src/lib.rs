@@ -52,14 +52,14 @@ mod error {
 
 pub use accel::baked::{BakeError, Baked};
 pub use accel::bvh::{Bvh, Node};
-pub use accel::wide::{Bvh4, Bvh8, Node4, Node8, WideBvh, WideNode};
 pub use accel::grid::Grid;
 pub use accel::kdtree::{KdNode, KdTree};
+pub use accel::wide::{Bvh4, Bvh8, Node4, Node8, WideBvh, WideNode};
 pub use accel::{
     Accel, AccelFamily, AccelKind, AccelMemory, AccelVisitor, AnyAccel, AnyFamily, Arena,
-    BuildError, Bvh4Family, Bvh8Family, BvhFamily, Counters, GridFamily, InvalidAccel, KdTreeFamily, Linear,
-    LinearFamily, MemoryNeeded, Nearest, NoStats, Shortfall, TraversalStats, TrianglesOnly,
-    UnknownAccel, MAX_PRIMS,
+    BuildError, Bvh4Family, Bvh8Family, BvhFamily, Counters, GridFamily, InvalidAccel,
+    KdTreeFamily, Linear, LinearFamily, MemoryNeeded, Nearest, NoStats, Shortfall, TraversalStats,
+    TrianglesOnly, UnknownAccel, MAX_PRIMS,
 };
 pub use geom::{
     spawn, Aabb, Barycentrics, Hit, Primitive, Ray, Sphere, Triangle, TriangleHit, VertexError,

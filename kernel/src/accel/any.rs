@@ -2,11 +2,13 @@
 //! dispatches over the structures.
 
 use super::bvh::{Bvh, InvalidTree};
-use super::wide::{Bvh4, Bvh8};
-use super::family::{AccelFamily, Bvh4Family, Bvh8Family, BvhFamily, GridFamily, KdTreeFamily, LinearFamily};
+use super::family::{
+    AccelFamily, Bvh4Family, Bvh8Family, BvhFamily, GridFamily, KdTreeFamily, LinearFamily,
+};
 use super::grid::{Grid, InvalidGrid};
 use super::kdtree::{InvalidKdTree, KdTree};
 use super::memory::take;
+use super::wide::{Bvh4, Bvh8};
 use super::{Accel, AccelKind, AccelMemory, BuildError, Counters, Linear, MemoryNeeded, Nearest};
 use crate::geom::{Barycentrics, Primitive, Ray};
 use crate::scalar::Scalar;

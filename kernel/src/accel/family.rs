@@ -3,10 +3,10 @@
 
 use super::any::AnyAccel;
 use super::bvh::{BuildOptions, BuildSettings, Bvh};
-use super::wide::{Bvh4, Bvh8};
 use super::grid::{Grid, GridOptions};
 use super::kdtree::{KdOptions, KdTree};
 use super::memory::take;
+use super::wide::{Bvh4, Bvh8};
 use super::{
     check_count, check_each, Accel, AccelKind, AccelMemory, BuildError, Linear, MemoryNeeded,
 };

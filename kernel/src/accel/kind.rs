@@ -1,7 +1,9 @@
 //! The run-time description of an accelerator: which structure, with which options.
 
 use super::bvh::BuildOptions;
-use super::family::{AccelFamily, Bvh4Family, Bvh8Family, BvhFamily, GridFamily, KdTreeFamily, LinearFamily};
+use super::family::{
+    AccelFamily, Bvh4Family, Bvh8Family, BvhFamily, GridFamily, KdTreeFamily, LinearFamily,
+};
 use super::grid::GridOptions;
 use super::kdtree::KdOptions;
 use super::{BuildError, MemoryNeeded};

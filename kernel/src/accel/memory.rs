@@ -1,9 +1,9 @@
 //! The caller's memory for accelerators, and how much of it a build takes.
 
 use super::bvh::{nodes_needed, Node};
-use super::wide::{nodes4_needed, nodes8_needed, Node4, Node8};
 use super::grid::GridSize;
 use super::kdtree::{self, KdNode};
+use super::wide::{nodes4_needed, nodes8_needed, Node4, Node8};
 use crate::scalar::Scalar;
 
 /// Memory for accelerator builds: one buffer per element type. A build takes its share from

@@ -7,7 +7,6 @@
 mod any;
 pub(crate) mod baked;
 pub(crate) mod bvh;
-pub(crate) mod wide;
 mod error;
 mod family;
 pub(crate) mod grid;
@@ -16,12 +15,13 @@ pub(crate) mod kdtree;
 mod kind;
 mod linear;
 mod memory;
+pub(crate) mod wide;
 
 pub use any::{AccelVisitor, AnyAccel, InvalidAccel};
 pub use error::{Arena, BuildError};
 pub use family::{
-    AccelFamily, AnyFamily, Bvh4Family, Bvh8Family, BvhFamily, GridFamily, KdTreeFamily, LinearFamily,
-    TrianglesOnly,
+    AccelFamily, AnyFamily, Bvh4Family, Bvh8Family, BvhFamily, GridFamily, KdTreeFamily,
+    LinearFamily, TrianglesOnly,
 };
 pub use input::MAX_PRIMS;
 pub(crate) use input::{check_count, check_each};

@@ -109,7 +109,8 @@ pub(super) unsafe fn slab8_avx(
             t_near = _mm256_max_ps(_mm256_min_ps(a, b), t_near);
             t_far = _mm256_min_ps(_mm256_max_ps(a, b), t_far);
         }
-        let inside = _mm256_cmp_ps::<_CMP_LE_OQ>(t_near, _mm256_mul_ps(t_far, _mm256_set1_ps(widen)));
+        let inside =
+            _mm256_cmp_ps::<_CMP_LE_OQ>(t_near, _mm256_mul_ps(t_far, _mm256_set1_ps(widen)));
         let mut t = [0.0f32; 8];
         _mm256_storeu_ps(t.as_mut_ptr(), t_near);
         (_mm256_movemask_ps(inside) as u32, t)

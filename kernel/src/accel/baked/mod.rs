@@ -56,7 +56,9 @@ impl<'a, S: BakedScalar> Baked<'a, S> {
         match accel {
             AnyAccel::Bvh(t) => Some(Self::Bvh(t)),
             AnyAccel::Bvh4(t) => Some(Self::Bvh4(t)),
-            AnyAccel::Linear(_) | AnyAccel::Bvh8(_) | AnyAccel::Grid(_) | AnyAccel::KdTree(_) => None,
+            AnyAccel::Linear(_) | AnyAccel::Bvh8(_) | AnyAccel::Grid(_) | AnyAccel::KdTree(_) => {
+                None
+            }
         }
     }
 

@@ -59,8 +59,11 @@ pub(super) trait Walk<S: Scalar> {
     /// Walks the tree. With `ANY`, returns at the first hit in range; otherwise finds the
     /// closest under [`closer`]. Returns (t, prim id, index into `prims`) of the hit;
     /// `prim id == u32::MAX` for none.
-    fn traverse<const ANY: bool, C: Counters>(&self, ray: &Ray<S>, stats: &mut C)
-        -> (S, u32, usize);
+    fn traverse<const ANY: bool, C: Counters>(
+        &self,
+        ray: &Ray<S>,
+        stats: &mut C,
+    ) -> (S, u32, usize);
 }
 
 impl<S: Scalar, P: Primitive<S>> Walk<S> for Bvh4<'_, S, P> {
