@@ -1,23 +1,30 @@
-//! The 4-wide BVH beyond the random differential tests of `properties.rs`:
+//! The wide BVHs (4-wide and 8-wide) beyond the random differential tests of `properties.rs`:
 //! - `Numerics::slab4` gives, box by box, exactly `Numerics::slab`'s decisions and entry bits
 //!   (random boxes and rays, zero and signed-zero direction components, origins on box
 //!   planes, flat boxes, intervals);
+//! - `Numerics::slab8` gives each of its eight boxes exactly the decision and entry bits
+//!   `slab4` gives it in its half, in both modes (so `slab`'s in `f32`), on the same kinds of
+//!   cases; where the CPU has AVX, `Numerics::slab8_avx` (256-bit lanes) gives `slab8`'s;
 //! - why unused slots are masked by their count rather than by an "empty" box: the slab test
 //!   accepts an inverted box for some ray;
-//! - the collapse: arena sizes (`nodes4_needed` is reached, one slot less is a typed error),
-//!   empty and one-primitive scenes, leaf order, and a deeper tree (a 5120-triangle sphere)
-//!   answering like the BVH2 and brute force bit for bit in both modes.
+//! - the collapse, for both widths: arena sizes (`wide_nodes_needed` bounds every collapse and
+//!   is reached, one slot less is a typed error), its values and growth, empty and
+//!   one-primitive scenes, leaf order, and a deeper tree (a 5120-triangle sphere) answering
+//!   like the BVH2 and brute force bit for bit in both modes.
 
 mod common;
 
 use common::{
-    c, query, same_hit, with_bvh, with_bvh4, with_bvh_in_leaf_order, RaySpec, TestScalar,
-    LEAF_SIZES,
+    c, query, same_hit, with_bvh, with_bvh_in_leaf_order, with_wide, RaySpec, TestScalar,
+    WideTree, LEAF_SIZES,
 };
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
+use raykernel::bvh8::{nodes8_needed, wide_nodes_needed};
 use raykernel::Arena;
-use raykernel::{Aabb, Accel, BuildError, Bvh, Bvh4, Linear, Node, Node4, Ray, Triangle, I16F16};
+use raykernel::{
+    Aabb, Accel, BuildError, Bvh, Linear, Node, Ray, Triangle, WideBvh, WideNode, I16F16,
+};
 use raykernel_testkit::icosphere::unit_icosphere;
 use raykernel_testkit::Rng;
 
@@ -26,7 +33,7 @@ fn tri<S: TestScalar>(v: [[f32; 3]; 3]) -> Triangle<S> {
 }
 
 // ---------------------------------------------------------------------------------------------
-// slab4 == slab, box by box
+// slab4 == slab, slab8 == slab4, box by box
 
 /// A random ray direction with some components +0 or -0 (never all zero).
 fn direction(rng: &mut Rng) -> [f32; 3] {
@@ -44,32 +51,38 @@ fn direction(rng: &mut Rng) -> [f32; 3] {
     d
 }
 
-// Fixed point's 4-wide box test runs in `f32` lanes where there are vector lanes and is
-// conservative rather than equal to `slab` there: tested against exact rational distances in
-// `scalar/fixed.rs` (`slab4_is_conservative_and_tight`). Elsewhere it is `slab` per box.
+/// `N` boxes in structure of arrays: `lo[axis][box]`, `hi[axis][box]`.
+type Boxes<S, const N: usize> = ([[S; N]; 3], [[S; N]; 3]);
 
-fn slab4_cases<S: TestScalar>() {
-    let mut rng = Rng::new(0x51ab_4444);
-    let (mut accepted, mut rejected) = (0usize, 0usize);
-    for case in 0..40_000 {
-        // Quarter-valued origins, so box planes can sit exactly on them.
+/// Box `b` of `boxes` as `(lo, hi)` points.
+fn box_at<S: Copy, const N: usize>((lo, hi): &Boxes<S, N>, b: usize) -> ([S; 3], [S; 3]) {
+    ([lo[0][b], lo[1][b], lo[2][b]], [hi[0][b], hi[1][b], hi[2][b]])
+}
+
+/// `count` random rays, each with `N` random boxes: quarter-valued origins (so box planes can
+/// sit exactly on them), directions with ±0 components, intervals `[0, inf)`, `[t, inf)` and
+/// bounded ones; box planes on the origin (rays in a face), random quarters, arbitrary values,
+/// and flat boxes (`lo == hi`).
+fn random_cases<S: TestScalar, const N: usize>(
+    seed: u64,
+    count: usize,
+) -> impl Iterator<Item = (RaySpec, Boxes<S, N>)> {
+    let mut rng = Rng::new(seed);
+    (0..count).map(move |_| {
         let o = [0, 1, 2].map(|_| (rng.range(-20.0, 20.0) * 4.0).round() / 4.0);
         let d = direction(&mut rng);
-        let (t_min, t_max) = match rng.below(4) {
-            0 | 1 => (0.0, f32::INFINITY),
-            2 => (rng.range(0.0, 10.0), f32::INFINITY),
+        let spec = match rng.below(4) {
+            0 | 1 => RaySpec::new(o, d),
+            2 => RaySpec::new(o, d).interval(rng.range(0.0, 10.0), f32::INFINITY),
             _ => {
                 let a = rng.range(0.0, 30.0);
-                (a, a + rng.range(0.0, 30.0))
+                RaySpec::new(o, d).interval(a, a + rng.range(0.0, 30.0))
             }
         };
-        let ray = Ray::<S>::from_f32(o, d, t_min, t_max).unwrap();
-        let mut lo = [[S::ZERO; 4]; 3];
-        let mut hi = [[S::ZERO; 4]; 3];
-        for b in 0..4 {
+        let mut lo = [[S::ZERO; N]; 3];
+        let mut hi = [[S::ZERO; N]; 3];
+        for b in 0..N {
             for k in 0..3 {
-                // Planes on the origin (rays in a face), random quarters, arbitrary values,
-                // and flat boxes (lo == hi).
                 let pick = |rng: &mut Rng| match rng.below(5) {
                     0 => o[k],
                     1 | 2 => (rng.range(-25.0, 25.0) * 4.0).round() / 4.0,
@@ -81,94 +94,237 @@ fn slab4_cases<S: TestScalar>() {
                 hi[k][b] = c::<S>(a.max(bb));
             }
         }
-        let (t_lo, t_hi) = (ray.t_min(), ray.t_max());
-        let (mask, t) = S::slab4(ray.data(), &lo, &hi, t_lo, t_hi);
-        assert!(mask < 16, "{} case {case}: mask {mask:#b}", S::NAME);
-        for b in 0..4 {
-            let l = [lo[0][b], lo[1][b], lo[2][b]];
-            let h = [hi[0][b], hi[1][b], hi[2][b]];
-            let want = S::slab(ray.data(), &l, &h, t_lo, t_hi);
-            let got = (mask & (1 << b) != 0).then_some(t[b]);
-            assert_eq!(
-                got.map(|x| x.bits()),
-                want.map(|x| x.bits()),
-                "{} case {case} box {b}: origin {o:?} dir {d:?} (bits {:x?}) t [{t_min}, {t_max}] \
-                 box {l:?} {h:?}",
-                S::NAME,
-                d.map(f32::to_bits)
-            );
-            if want.is_some() {
-                accepted += 1;
-            } else {
-                rejected += 1;
-            }
-        }
-    }
-    // Both outcomes are well represented.
-    assert!(
-        accepted > 20_000 && rejected > 20_000,
-        "{accepted} {rejected}"
-    );
+        (spec, (lo, hi))
+    })
 }
 
-#[test]
-fn slab4_equals_slab_per_box_f32() {
-    slab4_cases::<f32>();
-}
-
-/// Rays along the axes with ±0 components, on and off the faces of a unit box: every slab4
-/// lane agrees with slab (the 0 · inf = NaN paths of `f32`).
-fn slab4_axis_cases<S: TestScalar>() {
-    let boxes: [([f32; 3], [f32; 3]); 4] = [
-        ([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]),
-        ([0.0, 0.0, 0.0], [0.0, 1.0, 1.0]),
-        ([-1.0, 1.0, 0.0], [0.0, 1.0, 2.0]),
-        ([1.0, 1.0, 1.0], [1.0, 1.0, 1.0]),
-    ];
-    let mut lo = [[S::ZERO; 4]; 3];
-    let mut hi = [[S::ZERO; 4]; 3];
+/// Rays along the axes with ±0 components, from on, inside and outside the faces of `boxes`
+/// (the `0 · inf = NaN` paths of `f32`), each with `boxes`.
+fn axis_cases<S: TestScalar, const N: usize>(
+    boxes: [([f32; 3], [f32; 3]); N],
+) -> Vec<(RaySpec, Boxes<S, N>)> {
+    let mut planes = ([[S::ZERO; N]; 3], [[S::ZERO; N]; 3]);
     for (b, (l, h)) in boxes.iter().enumerate() {
         for k in 0..3 {
-            lo[k][b] = c::<S>(l[k]);
-            hi[k][b] = c::<S>(h[k]);
+            planes.0[k][b] = c::<S>(l[k]);
+            planes.1[k][b] = c::<S>(h[k]);
         }
     }
     let coords = [-1.0, 0.0, 0.5, 1.0, 2.0];
-    for &x in &coords {
-        for &y in &coords {
-            for &z in &coords {
+    let mut out = Vec::new();
+    for x in coords {
+        for y in coords {
+            for z in coords {
                 for axis in 0..3 {
                     for sign in [1.0f32, -1.0] {
                         for zeros in [0.0f32, -0.0] {
                             let mut d = [zeros; 3];
                             d[axis] = sign;
-                            let ray = Ray::<S>::from_f32([x, y, z], d, 0.0, f32::INFINITY).unwrap();
-                            let (mask, t) =
-                                S::slab4(ray.data(), &lo, &hi, ray.t_min(), ray.t_max());
-                            for b in 0..4 {
-                                let l = [lo[0][b], lo[1][b], lo[2][b]];
-                                let h = [hi[0][b], hi[1][b], hi[2][b]];
-                                let want = S::slab(ray.data(), &l, &h, ray.t_min(), ray.t_max());
-                                let got = (mask & (1 << b) != 0).then_some(t[b]);
-                                assert_eq!(
-                                    got.map(|v| v.bits()),
-                                    want.map(|v| v.bits()),
-                                    "{} origin {:?} dir {d:?} box {b}",
-                                    S::NAME,
-                                    [x, y, z]
-                                );
-                            }
+                            out.push((RaySpec::new([x, y, z], d), planes));
                         }
                     }
                 }
             }
         }
     }
+    out
+}
+
+/// Four boxes for [`axis_cases`]: a unit box, a flat one, one beside it, a point.
+const AXIS_BOXES4: [([f32; 3], [f32; 3]); 4] = [
+    ([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]),
+    ([0.0, 0.0, 0.0], [0.0, 1.0, 1.0]),
+    ([-1.0, 1.0, 0.0], [0.0, 1.0, 2.0]),
+    ([1.0, 1.0, 1.0], [1.0, 1.0, 1.0]),
+];
+
+/// Eight boxes for [`axis_cases`]: [`AXIS_BOXES4`], then one around every origin, one flat
+/// between the origins' planes, a point on the far corner and one below the unit box.
+const AXIS_BOXES8: [([f32; 3], [f32; 3]); 8] = [
+    AXIS_BOXES4[0],
+    AXIS_BOXES4[1],
+    AXIS_BOXES4[2],
+    AXIS_BOXES4[3],
+    ([-1.0, -1.0, -1.0], [2.0, 2.0, 2.0]),
+    ([0.5, 0.0, 0.0], [0.5, 1.0, 1.0]),
+    ([2.0, 2.0, 2.0], [2.0, 2.0, 2.0]),
+    ([0.0, 0.0, -1.0], [1.0, 1.0, 0.0]),
+];
+
+/// Per box: the entry's bits if accepted (bit `b` of `mask`), `None` if rejected (rejected
+/// boxes' entries are unspecified).
+fn decisions<S: TestScalar>(mask: u32, t: &[S]) -> Vec<Option<u32>> {
+    let n = t.len();
+    assert!(mask >> n == 0, "mask {mask:#b} has bits beyond box {n}");
+    t.iter()
+        .enumerate()
+        .map(|(b, t)| (mask >> b & 1 != 0).then(|| t.bits()))
+        .collect()
+}
+
+/// `Numerics::slab`'s decision for each box.
+fn slab_per_box<S: TestScalar, const N: usize>(
+    ray: &Ray<S>,
+    boxes: &Boxes<S, N>,
+) -> Vec<Option<u32>> {
+    (0..N)
+        .map(|b| {
+            let (l, h) = box_at(boxes, b);
+            S::slab(ray.data(), &l, &h, ray.t_min(), ray.t_max()).map(|t| t.bits())
+        })
+        .collect()
+}
+
+/// `Numerics::slab4`'s decisions for boxes 0..4, then for boxes 4..8.
+fn slab4_per_half<S: TestScalar>(ray: &Ray<S>, (lo, hi): &Boxes<S, 8>) -> Vec<Option<u32>> {
+    let half = |planes: &[[S; 8]; 3], h: usize| {
+        planes.map(|axis| std::array::from_fn::<S, 4, _>(|i| axis[4 * h + i]))
+    };
+    (0..2)
+        .flat_map(|h| {
+            let (mask, t) = S::slab4(
+                ray.data(),
+                &half(lo, h),
+                &half(hi, h),
+                ray.t_min(),
+                ray.t_max(),
+            );
+            decisions(mask, &t)
+        })
+        .collect()
+}
+
+/// Counts accepted and rejected boxes, so a test can show both outcomes are well represented.
+#[derive(Default)]
+struct Outcomes {
+    accepted: usize,
+    rejected: usize,
+}
+
+impl Outcomes {
+    fn add(&mut self, d: &[Option<u32>]) {
+        let accepted = d.iter().filter(|x| x.is_some()).count();
+        self.accepted += accepted;
+        self.rejected += d.len() - accepted;
+    }
+    fn assert_both_above(&self, n: usize) {
+        assert!(
+            self.accepted > n && self.rejected > n,
+            "accepted {}, rejected {}",
+            self.accepted,
+            self.rejected
+        );
+    }
+}
+
+// Fixed point's 4-wide box test runs in `f32` lanes where there are vector lanes and is
+// conservative rather than equal to `slab` there: tested against exact rational distances in
+// `scalar/fixed.rs` (`slab4_is_conservative_and_tight`). Elsewhere it is `slab` per box.
+
+/// `slab4`'s decisions and entries are `slab`'s, box by box. Returns the outcomes.
+fn slab4_equals_slab<S: TestScalar>(
+    cases: impl IntoIterator<Item = (RaySpec, Boxes<S, 4>)>,
+) -> Outcomes {
+    let mut outcomes = Outcomes::default();
+    for (i, (spec, boxes)) in cases.into_iter().enumerate() {
+        let ray = spec.ray::<S>();
+        let (lo, hi) = &boxes;
+        let (mask, t) = S::slab4(ray.data(), lo, hi, ray.t_min(), ray.t_max());
+        let want = slab_per_box(&ray, &boxes);
+        assert_eq!(
+            decisions(mask, &t),
+            want,
+            "{} case {i}: {spec}, boxes {boxes:?}",
+            S::NAME
+        );
+        outcomes.add(&want);
+    }
+    outcomes
+}
+
+#[test]
+fn slab4_equals_slab_per_box_f32() {
+    slab4_equals_slab::<f32>(random_cases(0x51ab_4444, 40_000)).assert_both_above(20_000);
 }
 
 #[test]
 fn slab4_equals_slab_on_axis_rays_f32() {
-    slab4_axis_cases::<f32>();
+    slab4_equals_slab::<f32>(axis_cases(AXIS_BOXES4)).assert_both_above(500);
+}
+
+/// `slab8`'s decisions and entries are those `slab4` gives each half, and, where
+/// `equals_slab`, `slab`'s per box. Returns the outcomes.
+fn slab8_equals_slab4<S: TestScalar>(
+    cases: impl IntoIterator<Item = (RaySpec, Boxes<S, 8>)>,
+    equals_slab: bool,
+) -> Outcomes {
+    let mut outcomes = Outcomes::default();
+    for (i, (spec, boxes)) in cases.into_iter().enumerate() {
+        let ray = spec.ray::<S>();
+        let (lo, hi) = &boxes;
+        let (mask, t) = S::slab8(ray.data(), lo, hi, ray.t_min(), ray.t_max());
+        let got = decisions(mask, &t);
+        let want = slab4_per_half(&ray, &boxes);
+        let ctx = || format!("{} case {i}: {spec}, boxes {boxes:?}", S::NAME);
+        assert_eq!(got, want, "slab8 vs slab4: {}", ctx());
+        if equals_slab {
+            assert_eq!(got, slab_per_box(&ray, &boxes), "slab8 vs slab: {}", ctx());
+        }
+        outcomes.add(&got);
+    }
+    outcomes
+}
+
+#[test]
+fn slab8_equals_slab4_per_half_f32() {
+    slab8_equals_slab4::<f32>(random_cases(0x51ab_8888, 20_000), true).assert_both_above(20_000);
+    slab8_equals_slab4::<f32>(axis_cases(AXIS_BOXES8), true).assert_both_above(1000);
+}
+
+#[test]
+fn slab8_equals_slab4_per_half_fixed() {
+    slab8_equals_slab4::<I16F16>(random_cases(0x51ab_8888, 20_000), false)
+        .assert_both_above(20_000);
+    slab8_equals_slab4::<I16F16>(axis_cases(AXIS_BOXES8), false).assert_both_above(1000);
+}
+
+/// `slab8_avx` (for `f32` the eight boxes in the 256-bit lanes of one AVX vector) gives every
+/// box exactly `slab8`'s decision and entry.
+#[cfg(target_arch = "x86_64")]
+fn slab8_avx_equals_slab8<S: TestScalar>(cases: impl IntoIterator<Item = (RaySpec, Boxes<S, 8>)>) {
+    assert!(std::is_x86_feature_detected!("avx"));
+    let mut outcomes = Outcomes::default();
+    for (i, (spec, (lo, hi))) in cases.into_iter().enumerate() {
+        let ray = spec.ray::<S>();
+        let (t_min, t_max) = (ray.t_min(), ray.t_max());
+        let (mask, t) = S::slab8(ray.data(), &lo, &hi, t_min, t_max);
+        // SAFETY: the CPU has AVX (asserted above), the one thing `slab8_avx` requires.
+        let (avx_mask, avx_t) = unsafe { S::slab8_avx(ray.data(), &lo, &hi, t_min, t_max) };
+        let want = decisions(mask, &t);
+        assert_eq!(
+            decisions(avx_mask, &avx_t),
+            want,
+            "{} case {i}: {spec}, boxes {:?}",
+            S::NAME,
+            (lo, hi)
+        );
+        outcomes.add(&want);
+    }
+    outcomes.assert_both_above(1000);
+}
+
+/// Where the CPU has AVX: [`slab8_avx_equals_slab8`] on random and axis cases, both modes.
+#[test]
+fn slab8_avx_equals_slab8_where_the_cpu_has_avx() {
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx") {
+        slab8_avx_equals_slab8::<f32>(random_cases(0xa7c8, 20_000));
+        slab8_avx_equals_slab8::<f32>(axis_cases(AXIS_BOXES8));
+        slab8_avx_equals_slab8::<I16F16>(random_cases(0xa7c8, 20_000));
+        slab8_avx_equals_slab8::<I16F16>(axis_cases(AXIS_BOXES8));
+        return;
+    }
+    eprintln!("skipped: slab8_avx needs an x86_64 CPU with AVX");
 }
 
 /// The reason unused slots are masked by `count`: an inverted box (`lo = +inf`, `hi = -inf`)
@@ -195,64 +351,91 @@ fn row<S: TestScalar>(n: usize) -> Vec<Triangle<S>> {
         .collect()
 }
 
-fn collapse_size_cases<S: TestScalar>() {
-    // Too small by one: a typed error naming the exact bound, for every size.
-    for n in [1usize, 2, 5, 8, 13, 100] {
+/// For a `W`-wide collapse: one slot short of [`wide_nodes_needed`] is a typed error naming
+/// the exact bound; collapses of rows of every size up to 300 (median and SAH, one primitive
+/// per leaf) stay within it; and it is reached: a perfect binary tree of `2W` leaves collapses
+/// into a full root over `W` nodes of two leaves each.
+fn collapse_size_cases<const W: usize, S: TestScalar>()
+where
+    for<'a> WideBvh<'a, S, Triangle<S>, W>: WideTree<S>,
+{
+    for n in [1usize, 2, 5, 8, 9, 13, 16, 17, 100] {
         let tris = row::<S>(n);
         let options = BuildOptions {
             max_leaf_size: 1,
             ..BuildOptions::default()
         };
         with_bvh::<S, _, _>(&tris, options, |bvh| {
-            let needed = nodes4_needed(n);
-            let mut short = vec![Node4::<S>::EMPTY; needed - 1];
+            let needed = wide_nodes_needed(n, W);
+            let mut short = vec![WideNode::<S, W>::EMPTY; needed - 1];
             assert_eq!(
-                Bvh4::collapse(bvh, &mut short).err(),
+                WideBvh::collapse(bvh, &mut short).err(),
                 Some(BuildError::ArenaTooSmall {
                     arena: Arena::Nodes,
                     needed,
                     available: needed - 1,
                 }),
-                "{} n = {n}",
+                "{} {W}-wide, n = {n}",
                 S::NAME
             );
-            with_bvh4(bvh, |wide| {
-                let stats = wide.validate().unwrap();
+            with_wide::<W, _, _, _>(bvh, |wide| {
+                let stats = wide.check().unwrap();
                 assert!(stats.node_count <= needed);
-                assert_eq!(wide.bytes_used(), stats.node_count * 128 + n * 4);
+                assert_eq!(wide.bytes_used(), stats.node_count * 32 * W + n * 4);
             });
         });
     }
-    // The bound is reached: a perfect binary tree of 8 leaves collapses into 5 wide nodes.
-    let tris = row::<S>(8);
+    let all = row::<S>(300);
+    for n in 1..=all.len() {
+        for builder in [BuilderKind::Median, BuilderKind::Sah] {
+            let options = BuildOptions {
+                builder,
+                max_leaf_size: 1,
+                reinsertion: true,
+            };
+            with_bvh::<S, _, _>(&all[..n], options, |bvh| {
+                with_wide::<W, _, _, _>(bvh, |wide| {
+                    let used = wide.check().unwrap().node_count;
+                    let bound = wide_nodes_needed(n, W);
+                    assert!(used <= bound, "{} {W}-wide, n = {n}: {used} > {bound}", S::NAME);
+                });
+            });
+        }
+    }
+    let tris = row::<S>(2 * W);
     let options = BuildOptions {
         builder: BuilderKind::Median,
         max_leaf_size: 1,
         reinsertion: false,
     };
     with_bvh::<S, _, _>(&tris, options, |bvh| {
-        assert_eq!(bvh.depth(), 3);
-        with_bvh4(bvh, |wide| {
-            assert_eq!(wide.nodes().len(), nodes4_needed(8));
-            assert_eq!(wide.nodes().len(), 5);
-            assert_eq!(wide.validate().unwrap().depth, 1);
+        assert_eq!(bvh.depth(), (2 * W).ilog2());
+        with_wide::<W, _, _, _>(bvh, |wide| {
+            assert_eq!(wide.nodes().len(), wide_nodes_needed(2 * W, W));
+            assert_eq!(wide.nodes().len(), W + 1);
+            assert_eq!(wide.check().unwrap().depth, 1);
         });
     });
 }
 
 #[test]
 fn collapse_arena_sizes_and_errors_f32() {
-    collapse_size_cases::<f32>();
+    collapse_size_cases::<4, f32>();
+    collapse_size_cases::<8, f32>();
 }
 
 #[test]
 fn collapse_arena_sizes_and_errors_fixed() {
-    collapse_size_cases::<I16F16>();
+    collapse_size_cases::<4, I16F16>();
+    collapse_size_cases::<8, I16F16>();
 }
 
+/// `wide_nodes_needed` at points worked out from its proof's inequalities, per width
+/// (`nodes4_needed` and `nodes8_needed` are it at 4 and 8); nondecreasing, at most one node
+/// per primitive, and about `W·n / 2(W - 1)` nodes: `(W - 1)·w <= (W / 2)·n + W - 1`.
 #[test]
-fn nodes4_needed_values_and_growth() {
-    let known = [
+fn wide_nodes_needed_values_and_growth() {
+    let known4 = [
         (0, 0),
         (1, 1),
         (2, 1),
@@ -262,45 +445,73 @@ fn nodes4_needed_values_and_growth() {
         (8, 5),
         (14, 9),
     ];
-    for (n, w) in known {
-        assert_eq!(nodes4_needed(n), w, "n = {n}");
+    // Width 8: 9 leaves need a node below the root; 15 fit a root over seven nodes of two
+    // leaves and a leaf; 16 a full root over eight such nodes; 17 no more (a second full node
+    // needs 23); 30 and 44: two and three full nodes over 15 and 22 others.
+    let known8 = [
+        (0, 0),
+        (1, 1),
+        (8, 1),
+        (9, 2),
+        (15, 8),
+        (16, 9),
+        (17, 9),
+        (30, 17),
+        (44, 25),
+    ];
+    for (n, w) in known4 {
+        assert_eq!(nodes4_needed(n), w, "4-wide, n = {n}");
     }
-    let mut prev = 0;
-    for n in 0..200_000 {
-        let w = nodes4_needed(n);
-        assert!(
-            w >= prev && w <= n.max(1) && 3 * w <= 2 * n + 3,
-            "n = {n}: {w}"
-        );
-        prev = w;
+    for (n, w) in known8 {
+        assert_eq!(nodes8_needed(n), w, "8-wide, n = {n}");
     }
-    // Large counts do not overflow.
-    let _ = nodes4_needed(usize::MAX);
+    for width in [4, 8] {
+        let c = width - 1;
+        let mut prev = 0;
+        for n in 0..200_000 {
+            let w = wide_nodes_needed(n, width);
+            assert!(
+                w >= prev && w <= n.max(1) && c * w <= width / 2 * n + c,
+                "{width}-wide, n = {n}: {w}"
+            );
+            let named = if width == 4 {
+                nodes4_needed(n)
+            } else {
+                nodes8_needed(n)
+            };
+            assert_eq!(named, w, "{width}-wide, n = {n}");
+            prev = w;
+        }
+        // Large counts do not overflow.
+        let _ = wide_nodes_needed(usize::MAX, width);
+    }
 }
 
-fn small_scene_cases<S: TestScalar>() {
+/// No primitives: no nodes, every ray misses. One primitive: a root with one leaf child.
+fn small_scene_cases<const W: usize, S: TestScalar>()
+where
+    for<'a> WideBvh<'a, S, Triangle<S>, W>: WideTree<S>,
+{
     let r = RaySpec::new([0.25, 0.25, 0.0], [0.0, 0.0, 1.0]).ray::<S>();
-    // No primitives: no nodes, every ray misses.
     let none: Vec<Triangle<S>> = Vec::new();
     let mut nodes: Vec<Node<S>> = Vec::new();
     let mut ids: Vec<u32> = Vec::new();
     let bvh = Bvh::build(&none, &mut nodes, &mut ids, BuildOptions::default()).unwrap();
-    let mut wide_nodes: Vec<Node4<S>> = Vec::new();
-    let wide = Bvh4::collapse(&bvh, &mut wide_nodes).unwrap();
+    let mut wide_nodes: Vec<WideNode<S, W>> = Vec::new();
+    let wide = WideBvh::collapse(&bvh, &mut wide_nodes).unwrap();
     assert!(wide.nodes().is_empty());
-    assert_eq!(wide.validate().unwrap().node_count, 0);
+    assert_eq!(wide.check().unwrap().node_count, 0);
     assert!(wide.intersect(&r).is_none() && !wide.occluded(&r));
 
-    // One primitive: a root with one leaf child.
     let one = row::<S>(1);
     let mut nodes = vec![Node::<S>::EMPTY; nodes_needed(1)];
     let mut ids = vec![0u32; 1];
     let bvh = Bvh::build(&one, &mut nodes, &mut ids, BuildOptions::default()).unwrap();
-    let mut wide_nodes = vec![Node4::<S>::EMPTY; nodes4_needed(1)];
-    let wide = Bvh4::collapse(&bvh, &mut wide_nodes).unwrap();
+    let mut wide_nodes = vec![WideNode::<S, W>::EMPTY; wide_nodes_needed(1, W)];
+    let wide = WideBvh::collapse(&bvh, &mut wide_nodes).unwrap();
     assert_eq!(wide.nodes().len(), 1);
     assert_eq!(wide.nodes()[0].child_count(), 1);
-    let stats = wide.validate().unwrap();
+    let stats = wide.check().unwrap();
     assert_eq!((stats.leaf_count, stats.depth), (1, 0));
     let hit = wide.intersect(&r).unwrap();
     assert_eq!((hit.t.bits(), hit.prim), (c::<S>(5.0).bits(), 0));
@@ -311,12 +522,14 @@ fn small_scene_cases<S: TestScalar>() {
 
 #[test]
 fn empty_and_one_primitive_scenes_f32() {
-    small_scene_cases::<f32>();
+    small_scene_cases::<4, f32>();
+    small_scene_cases::<8, f32>();
 }
 
 #[test]
 fn empty_and_one_primitive_scenes_fixed() {
-    small_scene_cases::<I16F16>();
+    small_scene_cases::<4, I16F16>();
+    small_scene_cases::<8, I16F16>();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -354,7 +567,13 @@ fn sphere_rays(seed: u64, count: usize) -> Vec<RaySpec> {
         .collect()
 }
 
-fn deep_tree_cases<S: TestScalar>() {
+/// The `W`-wide tree over the sphere, for every builder and leaf size, with and without leaf
+/// order: valid, within [`wide_nodes_needed`], no deeper than the BVH2, and answering every ray
+/// as brute force does.
+fn deep_tree_cases<const W: usize, S: TestScalar>()
+where
+    for<'a> WideBvh<'a, S, Triangle<S>, W>: WideTree<S>,
+{
     let tris = sphere::<S>(10.0);
     let rays = sphere_rays(0xb0b4, 600);
     let linear = Linear::new(&tris);
@@ -369,29 +588,30 @@ fn deep_tree_cases<S: TestScalar>() {
                 max_leaf_size,
                 reinsertion: true,
             };
+            let ctx = |what: &str, e: String, r: &RaySpec| {
+                format!("{} {W}-wide{what} {options:?}: {e}, ray {r}", S::NAME)
+            };
             with_bvh::<S, _, _>(&tris, options, |bvh| {
-                with_bvh4(bvh, |wide| {
-                    let stats = wide.validate().unwrap();
-                    assert!(stats.node_count <= nodes4_needed(tris.len()));
+                with_wide::<W, _, _, _>(bvh, |wide| {
+                    let stats = wide.check().unwrap();
+                    assert!(stats.node_count <= wide_nodes_needed(tris.len(), W));
                     assert!(stats.depth <= bvh.depth() as usize);
                     for (r, w) in rays.iter().zip(&want) {
                         let got = query(wide, &r.ray::<S>()).unwrap();
-                        same_hit(&got, w)
-                            .unwrap_or_else(|e| panic!("{} {options:?}: {e}, ray {r}", S::NAME));
+                        same_hit(&got, w).unwrap_or_else(|e| panic!("{}", ctx("", e, r)));
                     }
                 });
             });
             // Leaf order: the same answers through permuted primitives.
             let mut own = tris.clone();
             with_bvh_in_leaf_order(&mut own, options, |bvh| {
-                with_bvh4(bvh, |wide| {
+                with_wide::<W, _, _, _>(bvh, |wide| {
                     assert!(wide.is_leaf_order());
-                    wide.validate().unwrap();
+                    wide.check().unwrap();
                     for (r, w) in rays.iter().zip(&want) {
                         let got = query(wide, &r.ray::<S>()).unwrap();
-                        same_hit(&got, w).unwrap_or_else(|e| {
-                            panic!("{} leaf order {options:?}: {e}, ray {r}", S::NAME)
-                        });
+                        same_hit(&got, w)
+                            .unwrap_or_else(|e| panic!("{}", ctx(" leaf order", e, r)));
                     }
                 })
             });
@@ -400,11 +620,21 @@ fn deep_tree_cases<S: TestScalar>() {
 }
 
 #[test]
-fn deep_tree_answers_like_brute_force_f32() {
-    deep_tree_cases::<f32>();
+fn deep_bvh4_answers_like_brute_force_f32() {
+    deep_tree_cases::<4, f32>();
 }
 
 #[test]
-fn deep_tree_answers_like_brute_force_fixed() {
-    deep_tree_cases::<I16F16>();
+fn deep_bvh4_answers_like_brute_force_fixed() {
+    deep_tree_cases::<4, I16F16>();
+}
+
+#[test]
+fn deep_bvh8_answers_like_brute_force_f32() {
+    deep_tree_cases::<8, f32>();
+}
+
+#[test]
+fn deep_bvh8_answers_like_brute_force_fixed() {
+    deep_tree_cases::<8, I16F16>();
 }

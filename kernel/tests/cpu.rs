@@ -1,19 +1,20 @@
-//! The 4-wide BVH's two compiled copies of its traversal (`raykernel::cpu`) answer every query
-//! with the same bits, in both modes, and the AVX2 copy is chosen exactly where the standard
-//! library's feature detection finds its features. One test, in its own binary: it switches
-//! the process-wide choice.
+//! The two compiled copies of each wide BVH's traversal (`raykernel::cpu`; the 8-wide one's
+//! AVX2 copy tests its boxes in 256-bit lanes) answer every query with the same bits, in both
+//! modes and with and without leaf order, and the AVX2 copy is chosen exactly where the
+//! standard library's feature detection finds its features. One test, in its own binary: it
+//! switches the process-wide choice.
 
 mod common;
 
-use common::{dir_to, hit_bits, with_bvh, with_bvh4, with_bvh_in_leaf_order, RaySpec, TestScalar};
+use common::{dir_to, hit_bits, with_bvh, with_bvh_in_leaf_order, with_wide, RaySpec, TestScalar};
 use raykernel::bvh::BuildOptions;
 use raykernel::cpu::{set_traversal_simd, traversal_simd, Simd};
-use raykernel::{Accel, Bvh4, Triangle, I16F16};
+use raykernel::{Accel, Triangle, WideBvh, I16F16};
 use raykernel_testkit::icosphere::unit_icosphere;
 use raykernel_testkit::Rng;
 
 /// A closed sphere of 5120 triangles, inside a cloud of 1500 small random triangles that cross
-/// it and each other (nodes with three and four children hit, leaves to be popped again).
+/// it and each other (nodes with three or more children hit, leaves to be popped again).
 fn scene<S: TestScalar>() -> Vec<Triangle<S>> {
     let (verts, faces) = unit_icosphere(4);
     let mut tris: Vec<[[f32; 3]; 3]> = faces
@@ -68,8 +69,12 @@ fn rays() -> Vec<RaySpec> {
 /// in the instruction set in effect.
 type Answers = Vec<(Option<(u32, u32, u32, u32)>, bool)>;
 
-fn answers<S: TestScalar>(rays: &[RaySpec], leaf_order: bool) -> Answers {
-    let trace = |wide: &Bvh4<'_, S, Triangle<S>>| -> Answers {
+/// [`Answers`] of the `W`-wide BVH over [`scene`].
+fn answers<const W: usize, S: TestScalar>(rays: &[RaySpec], leaf_order: bool) -> Answers
+where
+    for<'a> WideBvh<'a, S, Triangle<S>, W>: Accel<S>,
+{
+    let trace = |wide: &WideBvh<'_, S, Triangle<S>, W>| -> Answers {
         rays.iter()
             .map(|spec| {
                 let ray = spec.ray::<S>();
@@ -80,9 +85,9 @@ fn answers<S: TestScalar>(rays: &[RaySpec], leaf_order: bool) -> Answers {
     let mut tris = scene::<S>();
     let options = BuildOptions::default();
     if leaf_order {
-        with_bvh_in_leaf_order(&mut tris, options, |bvh| with_bvh4(bvh, trace))
+        with_bvh_in_leaf_order(&mut tris, options, |bvh| with_wide(bvh, trace))
     } else {
-        with_bvh(&tris, options, |bvh| with_bvh4(bvh, trace))
+        with_bvh(&tris, options, |bvh| with_wide(bvh, trace))
     }
 }
 
@@ -124,26 +129,29 @@ fn both_copies_answer_alike_and_avx2_runs_where_detected() {
         return;
     }
     let rays = rays();
+    let cases = [(4, "f32"), (4, "fixed"), (8, "f32"), (8, "fixed")];
     for leaf_order in [false, true] {
-        for mode in ["f32", "fixed"] {
+        for (width, mode) in cases {
             let trace = |simd: Simd| {
                 assert_eq!(set_traversal_simd(simd), simd);
-                match mode {
-                    "f32" => answers::<f32>(&rays, leaf_order),
-                    _ => answers::<I16F16>(&rays, leaf_order),
+                match (width, mode) {
+                    (4, "f32") => answers::<4, f32>(&rays, leaf_order),
+                    (4, _) => answers::<4, I16F16>(&rays, leaf_order),
+                    (_, "f32") => answers::<8, f32>(&rays, leaf_order),
+                    _ => answers::<8, I16F16>(&rays, leaf_order),
                 }
             };
             let (base, avx2) = (trace(Simd::Baseline), trace(Simd::Avx2));
             let hits = base.iter().filter(|a| a.0.is_some()).count();
             assert!(
                 hits > rays.len() / 3 && hits < rays.len(),
-                "{mode}: {hits} hits of {}",
+                "{width}-wide {mode}: {hits} hits of {}",
                 rays.len()
             );
             for (i, (b, a)) in base.iter().zip(&avx2).enumerate() {
                 assert_eq!(
                     b, a,
-                    "{mode}, leaf order {leaf_order}, ray {i}: {}",
+                    "{width}-wide {mode}, leaf order {leaf_order}, ray {i}: {}",
                     rays[i]
                 );
             }

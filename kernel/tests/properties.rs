@@ -2,8 +2,8 @@
 //! and leaf sizes 1, 2, 4 and 8:
 //! - the tree passes `validate()` after every build (and respects the leaf size);
 //! - the BVH's closest hit equals brute force (`Linear`) bit for bit: t, primitive, u and v;
-//! - so does that of the 4-wide BVH collapsed from each tree (validated, within
-//!   `nodes4_needed`);
+//! - so do those of the 4-wide and the 8-wide BVH collapsed from each tree (validated, within
+//!   `nodes4_needed` / `nodes8_needed`);
 //! - so do the uniform grid's (densities 0.25, 2 and 8, each built into arenas of exactly the
 //!   counted size and validated) and the kd-tree's (automatic depth, depth 3 and the maximum,
 //!   built into the documented budgets and validated);
@@ -19,16 +19,16 @@
 mod common;
 
 use common::{
-    all_options, dir_to, query, same_hit, with_accel, with_bvh, with_bvh4, RaySpec, TestScalar,
-    GRID_DENSITIES, KD_DEPTHS,
+    all_options, dir_to, query, same_hit, with_accel, with_bvh, with_wide, RaySpec, TestScalar,
+    WideTree, GRID_DENSITIES, KD_DEPTHS,
 };
 use proptest::prelude::*;
 use proptest::test_runner::{Config as ProptestConfig, RngSeed};
 use raykernel::bvh::BuildOptions;
-use raykernel::bvh4::nodes4_needed;
+use raykernel::bvh8::wide_nodes_needed;
 use raykernel::{
-    grid::GridOptions, kdtree::KdOptions, Accel, AccelKind, Linear, Primitive, Sphere, Triangle,
-    I16F16,
+    grid::GridOptions, kdtree::KdOptions, Accel, AccelKind, Bvh, Linear, Primitive, Sphere,
+    Triangle, WideBvh, I16F16,
 };
 
 const SEED: u64 = 0x5eed_7a11_0001;
@@ -354,23 +354,9 @@ fn check_differential<S: TestScalar, P: Primitive<S> + std::fmt::Debug>(
                     ))
                 })?;
             }
-            // The 4-wide BVH collapsed from this tree: validates, fits the documented bound,
-            // and answers exactly as Linear does.
-            with_bvh4(bvh, |wide| -> Result<(), String> {
-                let stats = wide
-                    .validate()
-                    .map_err(|e| ctx(format!("bvh4 validate: {e}")))?;
-                if stats.node_count > nodes4_needed(prims.len()) {
-                    return Err(ctx(format!("bvh4 uses {} nodes", stats.node_count)));
-                }
-                for (r, want) in rays.iter().zip(&want) {
-                    let got = query(wide, &r.ray::<S>())
-                        .map_err(|e| ctx(format!("bvh4 {e}, ray {r}")))?;
-                    same_hit(&got, want)
-                        .map_err(|e| ctx(format!("BVH4 vs Linear: {e}, ray {r}")))?;
-                }
-                Ok(())
-            })
+            // The wide BVHs collapsed from this tree.
+            check_wide::<4, S, P>(bvh, rays, &want, &ctx)?;
+            check_wide::<8, S, P>(bvh, rays, &want, &ctx)
         })?;
     }
     // The uniform grid and the kd-tree: the same answers, bit for bit.
@@ -397,6 +383,34 @@ fn check_differential<S: TestScalar, P: Primitive<S> + std::fmt::Debug>(
         })?;
     }
     Ok(())
+}
+
+/// The `W`-wide BVH collapsed from `bvh` validates, fits the documented bound
+/// ([`wide_nodes_needed`]), and answers every ray exactly as `Linear` did (`want`).
+fn check_wide<const W: usize, S: TestScalar, P: Primitive<S>>(
+    bvh: &Bvh<'_, S, P>,
+    rays: &[RaySpec],
+    want: &[Option<raykernel::Hit<S>>],
+    ctx: &dyn Fn(String) -> String,
+) -> Result<(), String>
+where
+    for<'a> WideBvh<'a, S, P, W>: WideTree<S>,
+{
+    with_wide::<W, S, P, _>(bvh, |wide| {
+        let name = <WideBvh<'_, S, P, W> as WideTree<S>>::NAME;
+        let stats = wide
+            .check()
+            .map_err(|e| ctx(format!("{name} validate: {e}")))?;
+        if stats.node_count > wide_nodes_needed(bvh.prims().len(), W) {
+            return Err(ctx(format!("{name} uses {} nodes", stats.node_count)));
+        }
+        for (r, want) in rays.iter().zip(want) {
+            let got =
+                query(wide, &r.ray::<S>()).map_err(|e| ctx(format!("{name} {e}, ray {r}")))?;
+            same_hit(&got, want).map_err(|e| ctx(format!("{name} vs Linear: {e}, ray {r}")))?;
+        }
+        Ok(())
+    })
 }
 
 /// A closest hit, or why the query was inconsistent (see `common::query`).

@@ -1,6 +1,8 @@
 //! Owned caller memory for accelerator builds, sized exactly from [`MemoryNeeded`].
 
-use raykernel::{AccelKind, AccelMemory, KdNode, MemoryNeeded, Node, Node4, Node8, Primitive, Scalar};
+use raykernel::{
+    AccelKind, AccelMemory, KdNode, MemoryNeeded, Node, Node4, Node8, Primitive, Scalar,
+};
 use std::vec::Vec;
 
 /// The five buffers of an [`AccelMemory`], owned. Resizing keeps the allocations, so one value

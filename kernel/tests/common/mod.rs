@@ -1,12 +1,12 @@
 //! Helpers shared by the kernel's host-run test suites (each suite uses a subset).
 #![allow(dead_code)]
 
-use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
-use raykernel::bvh4::nodes4_needed;
+use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind, InvalidTree, TreeStats};
+use raykernel::bvh8::wide_nodes_needed;
 use raykernel::{
-    grid::GridOptions, kdtree, kdtree::KdOptions, Accel, AccelKind, AnyAccel, Bvh, Bvh4, Grid, Hit,
-    KdNode, KdTree, Node, Node4, PointError, Primitive, Ray, Scalar, F32_COORD_LIMIT,
-    FIXED_COORD_LIMIT, I16F16,
+    grid::GridOptions, kdtree, kdtree::KdOptions, Accel, AccelKind, AnyAccel, Bvh, Bvh4, Bvh8,
+    Grid, Hit, KdNode, KdTree, Node, PointError, Primitive, Ray, Scalar, WideBvh, WideNode,
+    F32_COORD_LIMIT, FIXED_COORD_LIMIT, I16F16,
 };
 pub use raykernel_testkit::golden::Bits;
 use raykernel_testkit::memory::OwnedMemory;
@@ -214,22 +214,49 @@ where
     f(&bvh)
 }
 
-/// Collapses `bvh` into a 4-wide BVH in an arena of exactly [`nodes4_needed`] slots and hands
-/// it to `f` (validation is the caller's).
-pub fn with_bvh4<S, P, R>(bvh: &Bvh<'_, S, P>, f: impl FnOnce(&Bvh4<'_, S, P>) -> R) -> R
+/// Collapses `bvh` into a `W`-wide BVH in an arena of exactly
+/// [`wide_nodes_needed`]`(n, W)` slots and hands it to `f` (validation is the caller's).
+pub fn with_wide<const W: usize, S, P, R>(
+    bvh: &Bvh<'_, S, P>,
+    f: impl FnOnce(&WideBvh<'_, S, P, W>) -> R,
+) -> R
 where
     S: Scalar,
     P: Primitive<S>,
 {
-    let mut nodes = vec![Node4::<S>::EMPTY; nodes4_needed(bvh.prims().len())];
-    let wide = Bvh4::collapse(bvh, &mut nodes).unwrap_or_else(|e| {
+    let mut nodes = vec![WideNode::<S, W>::EMPTY; wide_nodes_needed(bvh.prims().len(), W)];
+    let wide = WideBvh::collapse(bvh, &mut nodes).unwrap_or_else(|e| {
         panic!(
-            "{} bvh4 collapse ({} prims) failed: {e}",
+            "{} {W}-wide collapse ({} prims) failed: {e}",
             S::NAME,
             bvh.prims().len()
         )
     });
     f(&wide)
+}
+
+/// A wide BVH of either width, so a test is written once over the width: the kernel writes
+/// `validate` per width (each with its traversal's stack bound), and this trait reaches it.
+/// Generic tests ask for it as `for<'a> WideBvh<'a, S, P, W>: WideTree<S>`.
+pub trait WideTree<S: Scalar>: Accel<S> {
+    /// `bvh4` or `bvh8`, for messages.
+    const NAME: &'static str;
+    /// [`Bvh4::validate`] or [`Bvh8::validate`].
+    fn check(&self) -> Result<TreeStats, InvalidTree>;
+}
+
+impl<S: Scalar, P: Primitive<S>> WideTree<S> for Bvh4<'_, S, P> {
+    const NAME: &'static str = "bvh4";
+    fn check(&self) -> Result<TreeStats, InvalidTree> {
+        self.validate()
+    }
+}
+
+impl<S: Scalar, P: Primitive<S>> WideTree<S> for Bvh8<'_, S, P> {
+    const NAME: &'static str = "bvh8";
+    fn check(&self) -> Result<TreeStats, InvalidTree> {
+        self.validate()
+    }
 }
 
 /// Grid densities the differential tests build with: coarse, the default, fine.
