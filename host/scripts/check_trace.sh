@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Checks `raykernel trace` on the shared scenes: every BVH builder, the 4-wide BVH, the uniform grid
-# and the kd-tree against brute force, byte for byte.
+# Checks `raykernel trace` on the shared scenes: every BVH builder, the 4-wide and 8-wide BVHs, the
+# uniform grid and the kd-tree against brute force, byte for byte.
 #
 # usage: host/scripts/check_trace.sh RAYS_DIR
 #
@@ -8,9 +8,9 @@
 #   python3 ../shared/bench/make_rays.py --out RAYS_DIR bunny sponza kitchen
 #
 # For each scene, ray set and mode (f32, fixed):
-#   - traces the whole file with each builder (sah, median, midpoint), the 4-wide BVH (SAH), the
-#     grid and the kd-tree, and checks the six hit files are identical;
-#   - traces every STRIDE-th ray with --accel linear, each builder, the 4-wide BVH, the grid and
+#   - traces the whole file with each builder (sah, median, midpoint), the 4-wide and 8-wide BVHs
+#     (SAH), the grid and the kd-tree, and checks the seven hit files are identical;
+#   - traces every STRIDE-th ray with --accel linear, each builder, the wide BVHs, the grid and
 #     the kd-tree, and checks each strided hit file equals the linear one (cmp);
 # then prints the fixed-vs-f32 agreement of the SAH primary hits per scene (compare-hits --scene
 # --rays), which classifies every ray whose prim differs; any "unexplained" one (farther than the
@@ -35,7 +35,7 @@ scenes=${SCENES:-bunny sponza kitchen}
 kinds=${KINDS:-primary incoherent}
 scenes_dir=${SCENES_DIR:-$root/../shared/scenes}
 builders="sah median midpoint"
-accels="bvh4 grid kdtree"
+accels="bvh4 bvh8 grid kdtree"
 modes="f32 fixed"
 
 if [ -z "${HOST_BIN:-}" ]; then
@@ -109,7 +109,8 @@ for scene in $scenes; do
             done
             # Keep only what the agreement report below needs.
             rm -f "$out/$tag.median.hits" "$out/$tag.midpoint.hits" "$out/$tag".*.s"$stride".hits \
-                "$out/$tag.bvh4.hits" "$out/$tag.grid.hits" "$out/$tag.kdtree.hits"
+                "$out/$tag.bvh4.hits" "$out/$tag.bvh8.hits" "$out/$tag.grid.hits" \
+                "$out/$tag.kdtree.hits"
         done
     done
 done
@@ -139,5 +140,5 @@ if [ "$failures" -gt 0 ]; then
     echo "check_trace: $failures comparison(s) DIFFERENT or UNEXPLAINED" >&2
     exit 1
 fi
-echo "check_trace: all BVH, 4-wide BVH, grid and kd-tree hit files match brute force (stride $stride) and each other;" \
+echo "check_trace: all BVH, wide BVH, grid and kd-tree hit files match brute force (stride $stride) and each other;" \
     "fixed vs f32 differences are all within quantization"
