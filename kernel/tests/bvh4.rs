@@ -10,22 +10,26 @@
 //! - the collapse, for both widths: arena sizes (`wide_nodes_needed` bounds every collapse and
 //!   is reached, one slot less is a typed error), its values and growth, empty and
 //!   one-primitive scenes, leaf order, and a deeper tree (a 5120-triangle sphere) answering
-//!   like the BVH2 and brute force bit for bit in both modes.
+//!   like the BVH2 and brute force bit for bit in both modes;
+//! - the same through `AnyAccel` (`AccelKind::Bvh4`, `AccelKind::Bvh8`), built as is and in
+//!   leaf order into exactly the memory `AccelKind::memory_needed` gives.
 
 mod common;
 
 use common::{
-    c, query, same_hit, with_bvh, with_bvh_in_leaf_order, with_wide, RaySpec, TestScalar,
-    WideTree, LEAF_SIZES,
+    c, query, same_hit, with_bvh, with_bvh_in_leaf_order, with_wide, RaySpec, TestScalar, WideTree,
+    LEAF_SIZES,
 };
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
 use raykernel::bvh8::{nodes8_needed, wide_nodes_needed};
 use raykernel::Arena;
 use raykernel::{
-    Aabb, Accel, BuildError, Bvh, Linear, Node, Ray, Triangle, WideBvh, WideNode, I16F16,
+    Aabb, Accel, AccelKind, AnyAccel, BuildError, Bvh, Linear, Node, Ray, Triangle, WideBvh,
+    WideNode, I16F16,
 };
 use raykernel_testkit::icosphere::unit_icosphere;
+use raykernel_testkit::memory::OwnedMemory;
 use raykernel_testkit::Rng;
 
 fn tri<S: TestScalar>(v: [[f32; 3]; 3]) -> Triangle<S> {
@@ -56,7 +60,10 @@ type Boxes<S, const N: usize> = ([[S; N]; 3], [[S; N]; 3]);
 
 /// Box `b` of `boxes` as `(lo, hi)` points.
 fn box_at<S: Copy, const N: usize>((lo, hi): &Boxes<S, N>, b: usize) -> ([S; 3], [S; 3]) {
-    ([lo[0][b], lo[1][b], lo[2][b]], [hi[0][b], hi[1][b], hi[2][b]])
+    (
+        [lo[0][b], lo[1][b], lo[2][b]],
+        [hi[0][b], hi[1][b], hi[2][b]],
+    )
 }
 
 /// `count` random rays, each with `N` random boxes: quarter-valued origins (so box planes can
@@ -98,10 +105,11 @@ fn random_cases<S: TestScalar, const N: usize>(
     })
 }
 
-/// Rays along the axes with ±0 components, from on, inside and outside the faces of `boxes`
-/// (the `0 · inf = NaN` paths of `f32`), each with `boxes`.
+/// Rays along the axes with ±0 components from every origin on the grid `coords`³, each with
+/// `boxes`.
 fn axis_cases<S: TestScalar, const N: usize>(
     boxes: [([f32; 3], [f32; 3]); N],
+    coords: [f32; 5],
 ) -> Vec<(RaySpec, Boxes<S, N>)> {
     let mut planes = ([[S::ZERO; N]; 3], [[S::ZERO; N]; 3]);
     for (b, (l, h)) in boxes.iter().enumerate() {
@@ -110,7 +118,6 @@ fn axis_cases<S: TestScalar, const N: usize>(
             planes.1[k][b] = c::<S>(h[k]);
         }
     }
-    let coords = [-1.0, 0.0, 0.5, 1.0, 2.0];
     let mut out = Vec::new();
     for x in coords {
         for y in coords {
@@ -129,6 +136,39 @@ fn axis_cases<S: TestScalar, const N: usize>(
     }
     out
 }
+
+/// Origins for [`axis_cases`] on, inside and outside the faces of the `AXIS_BOXES`.
+const AXIS_COORDS: [f32; 5] = [-1.0, 0.0, 0.5, 1.0, 2.0];
+
+/// The smallest positive `f32`: how far the slab test shifts an origin of coordinates this
+/// small off itself (towards each plane, `lo - (o + d)` and `hi - (o - d)`).
+const T: f32 = f32::from_bits(1);
+
+/// Origins for [`axis_cases`] with the `TINY_BOXES`: planes of those lie exactly on the shifted
+/// origins of a zero direction component, where `f32`'s slab test meets `0 · inf = NaN` and
+/// decides by the operand order of `min` and `max`.
+const TINY_COORDS: [f32; 5] = [-T, -0.0, 0.0, T, 2.0 * T];
+
+/// Eight boxes for [`axis_cases`] with [`TINY_COORDS`]: planes on, just inside and just outside
+/// the shifted origins.
+const TINY_BOXES8: [([f32; 3], [f32; 3]); 8] = [
+    ([T, T, T], [1.0, 1.0, 1.0]),
+    ([-1.0, -1.0, -1.0], [-T, -T, -T]),
+    ([2.0 * T, 2.0 * T, 2.0 * T], [1.0, 1.0, 1.0]),
+    ([-1.0, -1.0, -1.0], [-2.0 * T, -2.0 * T, -2.0 * T]),
+    ([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]),
+    ([-T, -T, -T], [T, T, T]),
+    ([T, -1.0, -1.0], [1.0, 1.0, 1.0]),
+    ([-1.0, T, -1.0], [1.0, 1.0, -T]),
+];
+
+/// The first four [`TINY_BOXES8`].
+const TINY_BOXES4: [([f32; 3], [f32; 3]); 4] = [
+    TINY_BOXES8[0],
+    TINY_BOXES8[1],
+    TINY_BOXES8[2],
+    TINY_BOXES8[3],
+];
 
 /// Four boxes for [`axis_cases`]: a unit box, a flat one, one beside it, a point.
 const AXIS_BOXES4: [([f32; 3], [f32; 3]); 4] = [
@@ -249,7 +289,8 @@ fn slab4_equals_slab_per_box_f32() {
 
 #[test]
 fn slab4_equals_slab_on_axis_rays_f32() {
-    slab4_equals_slab::<f32>(axis_cases(AXIS_BOXES4)).assert_both_above(500);
+    slab4_equals_slab::<f32>(axis_cases(AXIS_BOXES4, AXIS_COORDS)).assert_both_above(500);
+    slab4_equals_slab::<f32>(axis_cases(TINY_BOXES4, TINY_COORDS)).assert_both_above(500);
 }
 
 /// `slab8`'s decisions and entries are those `slab4` gives each half, and, where
@@ -278,14 +319,16 @@ fn slab8_equals_slab4<S: TestScalar>(
 #[test]
 fn slab8_equals_slab4_per_half_f32() {
     slab8_equals_slab4::<f32>(random_cases(0x51ab_8888, 20_000), true).assert_both_above(20_000);
-    slab8_equals_slab4::<f32>(axis_cases(AXIS_BOXES8), true).assert_both_above(1000);
+    slab8_equals_slab4::<f32>(axis_cases(AXIS_BOXES8, AXIS_COORDS), true).assert_both_above(1000);
+    slab8_equals_slab4::<f32>(axis_cases(TINY_BOXES8, TINY_COORDS), true).assert_both_above(1000);
 }
 
 #[test]
 fn slab8_equals_slab4_per_half_fixed() {
     slab8_equals_slab4::<I16F16>(random_cases(0x51ab_8888, 20_000), false)
         .assert_both_above(20_000);
-    slab8_equals_slab4::<I16F16>(axis_cases(AXIS_BOXES8), false).assert_both_above(1000);
+    slab8_equals_slab4::<I16F16>(axis_cases(AXIS_BOXES8, AXIS_COORDS), false)
+        .assert_both_above(1000);
 }
 
 /// `slab8_avx` (for `f32` the eight boxes in the 256-bit lanes of one AVX vector) gives every
@@ -319,9 +362,10 @@ fn slab8_avx_equals_slab8_where_the_cpu_has_avx() {
     #[cfg(target_arch = "x86_64")]
     if std::is_x86_feature_detected!("avx") {
         slab8_avx_equals_slab8::<f32>(random_cases(0xa7c8, 20_000));
-        slab8_avx_equals_slab8::<f32>(axis_cases(AXIS_BOXES8));
+        slab8_avx_equals_slab8::<f32>(axis_cases(AXIS_BOXES8, AXIS_COORDS));
+        slab8_avx_equals_slab8::<f32>(axis_cases(TINY_BOXES8, TINY_COORDS));
         slab8_avx_equals_slab8::<I16F16>(random_cases(0xa7c8, 20_000));
-        slab8_avx_equals_slab8::<I16F16>(axis_cases(AXIS_BOXES8));
+        slab8_avx_equals_slab8::<I16F16>(axis_cases(AXIS_BOXES8, AXIS_COORDS));
         return;
     }
     eprintln!("skipped: slab8_avx needs an x86_64 CPU with AVX");
@@ -397,7 +441,11 @@ where
                 with_wide::<W, _, _, _>(bvh, |wide| {
                     let used = wide.check().unwrap().node_count;
                     let bound = wide_nodes_needed(n, W);
-                    assert!(used <= bound, "{} {W}-wide, n = {n}: {used} > {bound}", S::NAME);
+                    assert!(
+                        used <= bound,
+                        "{} {W}-wide, n = {n}: {used} > {bound}",
+                        S::NAME
+                    );
                 });
             });
         }
@@ -637,4 +685,49 @@ fn deep_bvh8_answers_like_brute_force_f32() {
 #[test]
 fn deep_bvh8_answers_like_brute_force_fixed() {
     deep_tree_cases::<8, I16F16>();
+}
+
+/// `AccelKind::Bvh4` and `AccelKind::Bvh8` through `AnyAccel`, as is and in leaf order
+/// (`AnyAccel::build_in_leaf_order` permutes the primitives): built into exactly the memory
+/// `memory_needed` gives, the structure asked for, valid, and answering like brute force over
+/// the primitives in their original order.
+fn any_accel_cases<S: TestScalar>() {
+    let tris = sphere::<S>(10.0);
+    let rays = sphere_rays(0xa11, 300);
+    let linear = Linear::new(&tris);
+    let want: Vec<_> = rays
+        .iter()
+        .map(|r| query(&linear, &r.ray::<S>()).unwrap())
+        .collect();
+    let options = BuildOptions::default();
+    for kind in [AccelKind::Bvh4(options), AccelKind::Bvh8(options)] {
+        for leaf_order in [false, true] {
+            let ctx = format!("{} {kind}, leaf order {leaf_order}", S::NAME);
+            let mut own = tris.clone();
+            let mut arena = OwnedMemory::<S>::for_kind(kind, &tris);
+            let accel = if leaf_order {
+                AnyAccel::build_in_leaf_order(kind, &mut own, &mut arena.memory())
+            } else {
+                AnyAccel::build(kind, &own, &mut arena.memory())
+            }
+            .unwrap_or_else(|e| panic!("{ctx}: {e}"));
+            assert_eq!(accel.name(), kind.name(), "{ctx}");
+            accel.validate().unwrap_or_else(|e| panic!("{ctx}: {e}"));
+            for (r, w) in rays.iter().zip(&want) {
+                let got = query(&accel, &r.ray::<S>()).unwrap();
+                same_hit(&got, w).unwrap_or_else(|e| panic!("{ctx}: {e}, ray {r}"));
+            }
+            assert_eq!(own != tris, leaf_order, "{ctx}: primitives permuted");
+        }
+    }
+}
+
+#[test]
+fn any_accel_builds_wide_trees_as_is_and_in_leaf_order_f32() {
+    any_accel_cases::<f32>();
+}
+
+#[test]
+fn any_accel_builds_wide_trees_as_is_and_in_leaf_order_fixed() {
+    any_accel_cases::<I16F16>();
 }

@@ -21,7 +21,7 @@ use raykernel::render::{
     Renderer, SamplerKind, Scene, SceneError, Settings, Shape, Tile,
 };
 use raykernel::{
-    AccelKind, AccelMemory, AnyFamily, KdNode, Node, Node4, Scalar, Sphere, Triangle, I16F16,
+    AccelKind, AccelMemory, AnyFamily, KdNode, Node, Node4, Node8, Scalar, Sphere, Triangle, I16F16,
 };
 
 /// Standard errors a mean may lie from its expected value (a false failure has probability
@@ -39,6 +39,7 @@ fn render_tiled<S: Scalar>(
     let mut objects = vec![ObjectSlot::<S>::EMPTY; n.objects];
     let mut nodes = vec![Node::<S>::EMPTY; n.accel.nodes];
     let mut nodes4 = vec![Node4::<S>::EMPTY; n.accel.nodes4];
+    let mut nodes8 = vec![Node8::<S>::EMPTY; n.accel.nodes8];
     let mut kd_nodes = vec![KdNode::<S>::EMPTY; n.accel.kd_nodes];
     let mut words = vec![0u32; n.accel.words];
     let memory = RenderMemory {
@@ -46,7 +47,7 @@ fn render_tiled<S: Scalar>(
         accel: AccelMemory {
             nodes: &mut nodes,
             nodes4: &mut nodes4,
-            nodes8: &mut [],
+            nodes8: &mut nodes8,
             kd_nodes: &mut kd_nodes,
             words: &mut words,
         },

@@ -1,7 +1,7 @@
 //! Refit: random meshes (triangle soups and a closed sphere), random motion (small jitter,
-//! large displacement, whole-mesh transforms), both modes, both tree kinds, with and without
-//! leaf order: after `refit` the tree is valid and answers every ray bit for bit as brute
-//! force over the moved triangles does.
+//! large displacement, whole-mesh transforms), both modes, every tree kind (binary, 4-wide,
+//! 8-wide), with and without leaf order: after `refit` the tree is valid and answers every ray
+//! bit for bit as brute force over the moved triangles does.
 
 mod common;
 
@@ -9,7 +9,8 @@ use common::{query, same_hit, TestScalar};
 use proptest::prelude::*;
 use raykernel::bvh::{nodes_needed, BuildOptions, RefitError};
 use raykernel::bvh4::nodes4_needed;
-use raykernel::{Bvh, Bvh4, Linear, Node, Node4, Ray, Triangle, I16F16};
+use raykernel::bvh8::nodes8_needed;
+use raykernel::{Bvh, Bvh4, Bvh8, Linear, Node, Node4, Node8, Ray, Triangle, I16F16};
 use raykernel_testkit::icosphere::unit_icosphere;
 use raykernel_testkit::Rng;
 
@@ -58,8 +59,8 @@ fn rays(rng: &mut Rng, n: usize) -> Vec<([f32; 3], [f32; 3])> {
         .collect()
 }
 
-/// Builds over `before`, refits to `after` (binary and 4-wide), checks both against brute
-/// force on `after`.
+/// Builds over `before`, refits to `after` (binary, 4-wide and 8-wide), checks each against
+/// brute force on `after`.
 fn check_refit<S: TestScalar>(
     before: &Verts,
     after: &Verts,
@@ -76,15 +77,17 @@ fn check_refit<S: TestScalar>(
     let mut nodes = vec![Node::<S>::EMPTY; nodes_needed(n)];
     let mut ids = vec![0u32; n];
     let mut nodes4 = vec![Node4::<S>::EMPTY; nodes4_needed(n)];
-    let (shape, shape4) = {
+    let mut nodes8 = vec![Node8::<S>::EMPTY; nodes8_needed(n)];
+    let (shape, shape4, shape8) = {
         let bvh = if leaf_order {
             Bvh::build_in_leaf_order(&mut tris, &mut nodes, &mut ids, options)
         } else {
             Bvh::build(&tris, &mut nodes, &mut ids, options)
         }
         .map_err(|e| e.to_string())?;
-        let wide = Bvh4::collapse(&bvh, &mut nodes4).map_err(|e| e.to_string())?;
-        (bvh.shape(), wide.shape())
+        let wide4 = Bvh4::collapse(&bvh, &mut nodes4).map_err(|e| e.to_string())?;
+        let wide8 = Bvh8::collapse(&bvh, &mut nodes8).map_err(|e| e.to_string())?;
+        (bvh.shape(), wide4.shape(), wide8.shape())
     };
     // Move: triangle with id `id` takes `after[id]`, wherever it sits.
     let moved_by_id = to_mode::<S>(after);
@@ -98,6 +101,8 @@ fn check_refit<S: TestScalar>(
     refit.validate().map_err(|e| format!("refit bvh: {e}"))?;
     let refit4 = Bvh4::refit(&moved, &mut nodes4, &ids, shape4).map_err(|e| e.to_string())?;
     refit4.validate().map_err(|e| format!("refit bvh4: {e}"))?;
+    let refit8 = Bvh8::refit(&moved, &mut nodes8, &ids, shape8).map_err(|e| e.to_string())?;
+    refit8.validate().map_err(|e| format!("refit bvh8: {e}"))?;
     for (o, d) in rays {
         let Ok(ray) = Ray::<S>::from_f32(*o, *d, 0.0, f32::INFINITY) else {
             continue;
@@ -106,6 +111,7 @@ fn check_refit<S: TestScalar>(
         let ctx = |e: String| format!("{} ray {o:?} {d:?}: {e}", S::NAME);
         same_hit(&query(&refit, &ray)?, &want).map_err(|e| ctx(format!("bvh {e}")))?;
         same_hit(&query(&refit4, &ray)?, &want).map_err(|e| ctx(format!("bvh4 {e}")))?;
+        same_hit(&query(&refit8, &ray)?, &want).map_err(|e| ctx(format!("bvh8 {e}")))?;
     }
     Ok(())
 }

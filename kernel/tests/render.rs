@@ -16,7 +16,7 @@ use raykernel::render::{
 };
 use raykernel::{
     grid::GridOptions, kdtree::KdOptions, AccelKind, AccelMemory, AnyFamily, KdNode, MemoryNeeded,
-    Node, Node4, Scalar, Sphere, Triangle, I16F16,
+    Node, Node4, Node8, Scalar, Sphere, Triangle, I16F16,
 };
 use std::f64::consts::PI;
 
@@ -70,6 +70,7 @@ struct Memory<'m, S: Scalar> {
     objects: Vec<ObjectSlot<'m, S>>,
     nodes: Vec<Node<S>>,
     nodes4: Vec<Node4<S>>,
+    nodes8: Vec<Node8<S>>,
     kd_nodes: Vec<KdNode<S>>,
     words: Vec<u32>,
 }
@@ -83,6 +84,7 @@ impl<'m, S: Scalar> Memory<'m, S> {
             objects: vec![ObjectSlot::EMPTY; n.objects],
             nodes: vec![Node::EMPTY; n.accel.nodes],
             nodes4: vec![Node4::EMPTY; n.accel.nodes4],
+            nodes8: vec![Node8::EMPTY; n.accel.nodes8],
             kd_nodes: vec![KdNode::EMPTY; n.accel.kd_nodes],
             words: vec![0; n.accel.words],
         }
@@ -93,7 +95,7 @@ impl<'m, S: Scalar> Memory<'m, S> {
             accel: AccelMemory {
                 nodes: &mut self.nodes,
                 nodes4: &mut self.nodes4,
-                nodes8: &mut [],
+                nodes8: &mut self.nodes8,
                 kd_nodes: &mut self.kd_nodes,
                 words: &mut self.words,
             },
@@ -584,10 +586,11 @@ fn tiles_equal_whole<S: Scalar>(d: &SceneData<'_>) {
         }
         let bits = |v: &[[f32; 3]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&whole), bits(&tiled), "{} {}", d.name, S::NAME);
-        // Brute force, the grid and the kd-tree give the same bits.
+        // Brute force, the wide BVHs, the grid and the kd-tree give the same bits.
         for accel in [
             AccelKind::Linear,
             AccelKind::Bvh4(BuildOptions::default()),
+            AccelKind::Bvh8(BuildOptions::default()),
             AccelKind::Grid(GridOptions::default()),
             AccelKind::KdTree(KdOptions::default()),
         ] {
@@ -1053,64 +1056,74 @@ fn buffers_and_tiles_are_checked_exactly() {
     };
     let bvh = AccelKind::Bvh(options);
     let bvh4 = AccelKind::Bvh4(options);
+    let bvh8 = AccelKind::Bvh8(options);
     let kd = AccelKind::KdTree(KdOptions::default());
     let grid = AccelKind::Grid(GridOptions::default());
     let needed = |accel| memory_needed::<f32, AnyFamily>(scene.objects, &accel);
-    let (bvh_need, bvh4_need, kd_need, grid_need) =
-        (needed(bvh), needed(bvh4), needed(kd), needed(grid));
-    let need = |nodes, nodes4, kd_nodes, words| RenderMemoryNeeded {
+    let (bvh_need, bvh4_need, bvh8_need, kd_need, grid_need) = (
+        needed(bvh),
+        needed(bvh4),
+        needed(bvh8),
+        needed(kd),
+        needed(grid),
+    );
+    let need = |nodes, nodes4, nodes8, kd_nodes, words| RenderMemoryNeeded {
         objects: 2,
         accel: MemoryNeeded {
             nodes,
             nodes4,
-            nodes8: 0,
+            nodes8,
             kd_nodes,
             words,
         },
     };
-    // Two objects of two triangles: BVH 2·(2n) nodes and n ids, the 4-wide BVH one wide node
+    // Two objects of two triangles: BVH 2·(2n) nodes and n ids, each wide BVH one wide node
     // each besides, kd-tree 4n+1 nodes and 6n refs; and for every structure the top-level BVH
     // over the two objects, 4 nodes and 2 ids.
-    assert_eq!(bvh_need, need(8 + 4, 0, 0, 4 + 2));
-    assert_eq!(bvh4_need, need(8 + 4, 2, 0, 4 + 2));
-    let bvh8_need = needed(AccelKind::Bvh8(options));
-    let mut bvh8_want = need(8 + 4, 0, 0, 4 + 2);
-    bvh8_want.accel.nodes8 = 2;
-    assert_eq!(bvh8_need, bvh8_want);
-    assert_eq!(kd_need, need(4, 0, 18, 24 + 2));
+    assert_eq!(bvh_need, need(8 + 4, 0, 0, 0, 4 + 2));
+    assert_eq!(bvh4_need, need(8 + 4, 2, 0, 0, 4 + 2));
+    assert_eq!(bvh8_need, need(8 + 4, 0, 2, 0, 4 + 2));
+    assert_eq!(kd_need, need(4, 0, 0, 18, 24 + 2));
     let g = grid_need.accel;
-    assert_eq!((g.nodes, g.nodes4, g.kd_nodes), (4, 0, 0));
+    assert_eq!((g.nodes, g.nodes4, g.nodes8, g.kd_nodes), (4, 0, 0, 0));
     assert!(g.words > 0);
     // One element short in each buffer: a typed error naming it, with the exact sizes.
     let cases = [
         (bvh, bvh_need),
         (bvh4, bvh4_need),
+        (bvh8, bvh8_need),
         (kd, kd_need),
         (grid, grid_need),
     ];
     for (accel, n) in cases {
         let a = n.accel;
+        let less = |x: usize| x.wrapping_sub(1);
         let shorts = [
             ("objects", 2, RenderMemoryNeeded { objects: 1, ..n }),
             (
                 "nodes",
                 a.nodes,
-                need(a.nodes.wrapping_sub(1), a.nodes4, a.kd_nodes, a.words),
+                need(less(a.nodes), a.nodes4, a.nodes8, a.kd_nodes, a.words),
             ),
             (
                 "nodes4",
                 a.nodes4,
-                need(a.nodes, a.nodes4.wrapping_sub(1), a.kd_nodes, a.words),
+                need(a.nodes, less(a.nodes4), a.nodes8, a.kd_nodes, a.words),
+            ),
+            (
+                "nodes8",
+                a.nodes8,
+                need(a.nodes, a.nodes4, less(a.nodes8), a.kd_nodes, a.words),
             ),
             (
                 "kd_nodes",
                 a.kd_nodes,
-                need(a.nodes, a.nodes4, a.kd_nodes.wrapping_sub(1), a.words),
+                need(a.nodes, a.nodes4, a.nodes8, less(a.kd_nodes), a.words),
             ),
             (
                 "words",
                 a.words,
-                need(a.nodes, a.nodes4, a.kd_nodes, a.words - 1),
+                need(a.nodes, a.nodes4, a.nodes8, a.kd_nodes, a.words - 1),
             ),
         ];
         for (field, needed, short) in shorts {

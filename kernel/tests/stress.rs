@@ -505,9 +505,9 @@ fn interior(mesh: &Mesh, target: [f64; 3], rng: &mut Rng) -> [f64; 3] {
 // Accelerators and per-ray checks.
 
 /// The structures every ray goes through, each checked against the first (SAH/4, the answer):
-/// median/1, midpoint/8, the 4-wide BVH, the uniform grid and the kd-tree (default options),
-/// and brute force on every `linear_stride`-th ray.
-fn kinds() -> [AccelKind; 6] {
+/// median/1, midpoint/8, the 4-wide and the 8-wide BVH (SAH/4), the uniform grid and the
+/// kd-tree (default options), and brute force on every `linear_stride`-th ray.
+fn kinds() -> [AccelKind; 7] {
     let bvh = |builder, max_leaf_size| BuildOptions {
         builder,
         max_leaf_size,
@@ -518,6 +518,7 @@ fn kinds() -> [AccelKind; 6] {
         AccelKind::Bvh(bvh(BuilderKind::Median, 1)),
         AccelKind::Bvh(bvh(BuilderKind::Midpoint, 8)),
         AccelKind::Bvh4(bvh(BuilderKind::Sah, 4)),
+        AccelKind::Bvh8(bvh(BuilderKind::Sah, 4)),
         AccelKind::Grid(GridOptions::DEFAULT),
         AccelKind::KdTree(KdOptions::DEFAULT),
     ]

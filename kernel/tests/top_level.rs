@@ -11,7 +11,7 @@ use raykernel::render::{
 };
 use raykernel::{
     AccelFamily, AccelKind, AccelMemory, AnyFamily, BvhFamily, KdNode, LinearFamily, Node, Node4,
-    Scalar, Sphere, I16F16,
+    Node8, Scalar, Sphere, I16F16,
 };
 use raykernel_testkit::Rng;
 
@@ -67,6 +67,7 @@ fn render<S: Scalar, F: AccelFamily<S>>(objects: &[Object<'_, S>], options: F::O
     let need = memory_needed::<S, F>(objects, &options);
     let mut nodes = vec![Node::<S>::EMPTY; need.accel.nodes];
     let mut nodes4 = vec![Node4::<S>::EMPTY; need.accel.nodes4];
+    let mut nodes8 = vec![Node8::<S>::EMPTY; need.accel.nodes8];
     let mut kd_nodes = vec![KdNode::<S>::EMPTY; need.accel.kd_nodes];
     let mut words = vec![0u32; need.accel.words];
     // Leaked: generic over `F`, a vector of slots borrowing from itself for the renderer's
@@ -77,7 +78,7 @@ fn render<S: Scalar, F: AccelFamily<S>>(objects: &[Object<'_, S>], options: F::O
         accel: AccelMemory {
             nodes: &mut nodes,
             nodes4: &mut nodes4,
-            nodes8: &mut [],
+            nodes8: &mut nodes8,
             kd_nodes: &mut kd_nodes,
             words: &mut words,
         },
