@@ -1,10 +1,10 @@
 //! Arbitrary bytes -> a triangle scene and a few rays, in both number modes.
 //!
-//! Checks, for every structure of [`kinds`] (every BVH builder and leaf size, the 4-wide BVH,
-//! the grid and the kd-tree, built through `AnyAccel`; plus one leaf-order build): the structure
-//! validates, its closest hit equals brute force (`Linear`) bit for bit (t bits, prim, u bits,
-//! v bits), `occluded() == intersect().is_some()` for both, hits
-//! lie in the ray's interval with barycentrics in [0, 1]; arenas one slot too small give
+//! Checks, for every structure of [`kinds`] (every BVH builder and leaf size, the 4-wide and
+//! the 8-wide BVH, the grid and the kd-tree, built through `AnyAccel`; plus one leaf-order
+//! build): the structure validates, its closest hit equals brute force (`Linear`) bit for bit
+//! (t bits, prim, u bits, v bits), `occluded() == intersect().is_some()` for both, hits lie in
+//! the ray's interval with barycentrics in [0, 1]; arenas one slot too small give
 //! `ArenaTooSmall`; bad vertices give `BadPrimitive` (the same one `Triangle::from_f32` names);
 //! spawned rays (`raykernel::spawn`) are valid and never panic. Nothing may panic.
 #![no_main]
@@ -368,8 +368,8 @@ fn check_mode<S: Mode>(tris_f32: &[[[f32; 3]; 3]], rays_in: &[RayIn]) {
 }
 
 /// Every structure checked against brute force: each BVH builder at leaf sizes 1, 2, 4 and 8,
-/// the 4-wide BVH collapsed from each builder's leaf-4 tree, the grid at three densities and the
-/// kd-tree at the automatic and the deepest depth limit.
+/// the 4-wide and the 8-wide BVH collapsed from each builder's leaf-4 tree, the grid at three
+/// densities and the kd-tree at the automatic and the deepest depth limit.
 fn kinds() -> Vec<AccelKind> {
     let mut kinds = Vec::new();
     for builder in BuilderKind::ALL {
@@ -380,11 +380,13 @@ fn kinds() -> Vec<AccelKind> {
                 reinsertion: true,
             }));
         }
-        kinds.push(AccelKind::Bvh4(BuildOptions {
+        let wide = BuildOptions {
             builder,
             max_leaf_size: 4,
             reinsertion: true,
-        }));
+        };
+        kinds.push(AccelKind::Bvh4(wide));
+        kinds.push(AccelKind::Bvh8(wide));
     }
     for density in [0.25, GridOptions::DEFAULT.density, 8.0] {
         kinds.push(AccelKind::Grid(GridOptions { density }));

@@ -59,10 +59,10 @@ fn rays() -> Vec<([f32; 3], [f32; 3], f32, f32)> {
         .collect()
 }
 
-/// Every structure, in file order: brute force, the SAH BVH and the 4-wide BVH collapsed from
-/// it, the median and midpoint BVHs (all leaf size 4), the grid and the kd-tree (defaults).
-/// A BVH's file is named after its builder too (`bvh_sah`, `bvh4_sah`).
-fn kinds() -> [AccelKind; 7] {
+/// Every structure, in file order: brute force, the SAH BVH and the 4-wide and 8-wide BVHs
+/// collapsed from it, the median and midpoint BVHs (all leaf size 4), the grid and the kd-tree
+/// (defaults). A BVH's file is named after its builder too (`bvh_sah`, `bvh4_sah`, `bvh8_sah`).
+fn kinds() -> [AccelKind; 8] {
     let bvh = |builder| BuildOptions {
         builder,
         max_leaf_size: 4,
@@ -72,6 +72,7 @@ fn kinds() -> [AccelKind; 7] {
         AccelKind::Linear,
         AccelKind::Bvh(bvh(BuilderKind::Sah)),
         AccelKind::Bvh4(bvh(BuilderKind::Sah)),
+        AccelKind::Bvh8(bvh(BuilderKind::Sah)),
         AccelKind::Bvh(bvh(BuilderKind::Median)),
         AccelKind::Bvh(bvh(BuilderKind::Midpoint)),
         AccelKind::Grid(GridOptions::DEFAULT),
