@@ -145,11 +145,21 @@ where
         prims: &'a [P],
         memory: &mut AccelMemory<'a, S>,
     ) -> Result<Bvh<'a, S, P>, BuildError> {
-        let need = MemoryNeeded::bvh(prims.len());
-        let nodes = take(&mut memory.nodes, need.nodes);
-        let ids = take(&mut memory.words, need.words);
-        Bvh::build(prims, nodes, ids, *options)
+        binary_in(options, prims, memory)
     }
+}
+
+/// The binary BVH over `prims`, built into [`MemoryNeeded::bvh`] taken from `memory` (the
+/// wide BVHs collapse it: for them it is build scratch).
+fn binary_in<'a, S: Scalar, P: Primitive<S> + 'a, B: BuildSettings>(
+    options: &B,
+    prims: &'a [P],
+    memory: &mut AccelMemory<'a, S>,
+) -> Result<Bvh<'a, S, P>, BuildError> {
+    let need = MemoryNeeded::bvh(prims.len());
+    let nodes = take(&mut memory.nodes, need.nodes);
+    let ids = take(&mut memory.words, need.words);
+    Bvh::build(prims, nodes, ids, *options)
 }
 
 impl<S: Scalar> AccelFamily<S> for Bvh4Family {
@@ -170,12 +180,8 @@ impl<S: Scalar> AccelFamily<S> for Bvh4Family {
         prims: &'a [P],
         memory: &mut AccelMemory<'a, S>,
     ) -> Result<Bvh4<'a, S, P>, BuildError> {
-        let need = MemoryNeeded::bvh4(prims.len());
-        let nodes = take(&mut memory.nodes, need.nodes);
-        let ids = take(&mut memory.words, need.words);
-        let nodes4 = take(&mut memory.nodes4, need.nodes4);
-        let binary = Bvh::build(prims, nodes, ids, *options)?;
-        Bvh4::collapse(&binary, nodes4)
+        let nodes4 = take(&mut memory.nodes4, MemoryNeeded::bvh4(prims.len()).nodes4);
+        Bvh4::collapse(&binary_in(options, prims, memory)?, nodes4)
     }
 }
 
@@ -197,12 +203,8 @@ impl<S: Scalar> AccelFamily<S> for Bvh8Family {
         prims: &'a [P],
         memory: &mut AccelMemory<'a, S>,
     ) -> Result<Bvh8<'a, S, P>, BuildError> {
-        let need = MemoryNeeded::bvh8(prims.len());
-        let nodes = take(&mut memory.nodes, need.nodes);
-        let ids = take(&mut memory.words, need.words);
-        let nodes8 = take(&mut memory.nodes8, need.nodes8);
-        let binary = Bvh::build(prims, nodes, ids, *options)?;
-        Bvh8::collapse(&binary, nodes8)
+        let nodes8 = take(&mut memory.nodes8, MemoryNeeded::bvh8(prims.len()).nodes8);
+        Bvh8::collapse(&binary_in(options, prims, memory)?, nodes8)
     }
 }
 

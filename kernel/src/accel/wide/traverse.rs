@@ -199,19 +199,28 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                     return best;
                 }
             }
-            // Pop the next child still in reach of the current best.
-            loop {
-                let Some((c, k, t_near)) = stack.pop() else {
-                    break 'walk;
-                };
-                if t_near <= S::widen(best.0) {
-                    (child, count) = (c, k);
-                    continue 'walk;
-                }
+            match pop_in_reach(&mut stack, best.0) {
+                Some(next) => (child, count) = next,
+                None => break 'walk,
             }
         }
         best
     }
+}
+
+/// Pops entries until one is still in reach of the best hit so far (entered by
+/// `widen(best_t)`): its `(child, count)`; `None` once the stack is empty.
+#[inline(always)]
+pub(super) fn pop_in_reach<S: Scalar, const N: usize>(
+    stack: &mut heapless::Vec<(u32, u32, S), N>,
+    best_t: S,
+) -> Option<(u32, u32)> {
+    while let Some((child, count, t_near)) = stack.pop() {
+        if t_near <= S::widen(best_t) {
+            return Some((child, count));
+        }
+    }
+    None
 }
 
 impl<S: Scalar, P: Primitive<S>, const W: usize> WideBvh<'_, S, P, W> {

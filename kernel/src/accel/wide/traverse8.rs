@@ -3,7 +3,7 @@
 //! (`Numerics::slab8`), or in the 256-bit lanes of one AVX vector (`Numerics::slab8_avx`)
 //! where the CPU has it: the same bits either way.
 
-use super::traverse::Walk;
+use super::traverse::{pop_in_reach, Walk};
 use super::Bvh8;
 use crate::accel::bvh::{test_leaf, MAX_DEPTH};
 use crate::accel::Counters;
@@ -172,15 +172,9 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
                     return best;
                 }
             }
-            // Pop the next child still in reach of the current best.
-            loop {
-                let Some((c, k, t_near)) = stack.pop() else {
-                    break 'walk;
-                };
-                if t_near <= S::widen(best.0) {
-                    (child, count) = (c, k);
-                    continue 'walk;
-                }
+            match pop_in_reach(&mut stack, best.0) {
+                Some(next) => (child, count) = next,
+                None => break 'walk,
             }
         }
         best
