@@ -10,13 +10,16 @@ fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").expect("OUT_DIR"));
     // memory.x.in says 16 KB of RAM, the micro:bit's own (the M0, QEMU's micro:bit machine);
     // the LM3S6965 and the MPS2 get 64 KB.
+    // The same size is `raykernel_qemu::RAM_BYTES` (ram.rs), for tests that size scenes by it.
     let memory = fs::read_to_string("memory.x.in").expect("read memory.x.in");
-    let memory = if env::var("TARGET").is_ok_and(|t| t != "thumbv6m-none-eabi") {
-        memory.replace("LENGTH = 16K", "LENGTH = 64K")
+    let ram_kb = if env::var("TARGET").is_ok_and(|t| t != "thumbv6m-none-eabi") {
+        64
     } else {
-        memory
+        16
     };
+    let memory = memory.replace("LENGTH = 16K", &format!("LENGTH = {ram_kb}K"));
     fs::write(out.join("memory.x"), memory).expect("write memory.x");
+    fs::write(out.join("ram.rs"), format!("{}\n", ram_kb * 1024)).expect("write ram.rs");
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed=memory.x.in");
 

@@ -292,16 +292,17 @@ fn readme_example_matches() -> bool {
 }
 
 /// Release-links `panic_never` (BVH, brute force, rays, I16F16), `panic_never_accels` (grid,
-/// kd-tree), `panic_never_bvh4` (4-wide BVH), `panic_never_render` and
-/// `panic_never_render_fixed` (the renderer with every accelerator, `f32` and fixed point) for
-/// every target;
-/// returns (passed, failed), one count per binary and target.
+/// kd-tree), `panic_never_bvh4` and `panic_never_bvh8` (4-wide and 8-wide BVH),
+/// `panic_never_render` and `panic_never_render_fixed` (the renderer with every accelerator,
+/// `f32` and fixed point) for every target; returns (passed, failed), one count per binary and
+/// target.
 fn panic_check() -> (usize, usize) {
     let (mut passed, mut failed) = (0, 0);
     let bins = [
         "panic_never",
         "panic_never_accels",
         "panic_never_bvh4",
+        "panic_never_bvh8",
         "panic_never_render",
         "panic_never_render_fixed",
     ];

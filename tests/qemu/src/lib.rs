@@ -15,10 +15,34 @@ pub mod golden {
 }
 
 use cases::Fail;
-use raykernel::bvh::{Sah, StaticBuild};
+use raykernel::bvh::{InvalidTree, Sah, StaticBuild, TreeStats};
 use raykernel::render::scenes::SceneData;
 use raykernel::render::AllFeatures;
-use raykernel::{BvhFamily, Scalar};
+use raykernel::{Accel, Bvh4, Bvh8, BvhFamily, Primitive, Scalar};
+
+/// RAM of the machine the tests run on, as build.rs sizes memory.x: 16 KB on the M0's
+/// micro:bit, 64 KB on the LM3S6965 (M3) and the MPS2 (M4F).
+pub const RAM_BYTES: usize = include!(concat!(env!("OUT_DIR"), "/ram.rs"));
+
+/// A wide BVH of either width, so on-target code is written once over the width
+/// (`WideBvh<'_, S, P, W>` with `W` = 4 or 8): the kernel writes `validate` per width (each
+/// with its traversal's stack bound), and this trait reaches it.
+pub trait WideTree<S: Scalar>: Accel<S> {
+    /// `Bvh4::validate` or `Bvh8::validate`.
+    fn check(&self) -> Result<TreeStats, InvalidTree>;
+}
+
+impl<S: Scalar, P: Primitive<S>> WideTree<S> for Bvh4<'_, S, P> {
+    fn check(&self) -> Result<TreeStats, InvalidTree> {
+        self.validate()
+    }
+}
+
+impl<S: Scalar, P: Primitive<S>> WideTree<S> for Bvh8<'_, S, P> {
+    fn check(&self) -> Result<TreeStats, InvalidTree> {
+        self.validate()
+    }
+}
 
 /// A short description of a failed case.
 pub fn fail_name(f: Fail) -> &'static str {
@@ -122,5 +146,19 @@ pub mod stack {
     /// The top of the stack (the end of RAM).
     pub fn stack_top() -> usize {
         core::ptr::addr_of!(_stack_start) as usize
+    }
+
+    /// Logs how much of the stack the run used since [`paint`] (down from the end of RAM) and
+    /// fails when less than 512 bytes of the target's RAM stayed free, before an overflow would.
+    pub fn assert_headroom() {
+        let top = stack_top();
+        let low = lowest_used(top);
+        let free = low - stack_bottom();
+        defmt::info!(
+            "stack peak of the run: {=usize} B used, {=usize} B free",
+            top - low,
+            free
+        );
+        defmt::assert!(free >= 512, "only {=usize} bytes of stack left", free);
     }
 }

@@ -436,14 +436,6 @@ mod tests {
     /// the target's RAM stay free, before an overflow would.
     #[test]
     fn stack_headroom_of_the_whole_run() {
-        let top = stack::stack_top();
-        let low = stack::lowest_used(top);
-        let free = low - stack::stack_bottom();
-        defmt::info!(
-            "stack peak of the run: {=usize} B used, {=usize} B free",
-            top - low,
-            free
-        );
-        defmt::assert!(free >= 512, "only {=usize} bytes of stack left", free);
+        stack::assert_headroom();
     }
 }
