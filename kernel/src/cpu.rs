@@ -1,12 +1,14 @@
 //! Which instruction set the traversal hot loop runs in.
 //!
-//! On `x86_64` targets not already compiled for AVX2, the 4-wide BVH's traversal
-//! ([`crate::Bvh4`]) exists twice: as compiled for the target, and compiled for AVX2 (with BMI1,
-//! BMI2, LZCNT and POPCNT). The first query detects the CPU's features (`cpuid`, and `xgetbv`
-//! for the operating system's support of the 256-bit registers) and every query from then on
-//! runs the AVX2 copy where they are present. Both copies perform the same IEEE operations in
-//! the same order (the vector lanes are the same 128-bit operations, VEX-encoded; no fused
-//! multiply-add is enabled), so they return the same bits; `kernel/tests/cpu.rs` compares them.
+//! On `x86_64` targets not already compiled for AVX2, the wide BVHs' traversals
+//! ([`crate::Bvh4`], [`crate::Bvh8`]) exist twice: as compiled for the target, and compiled for
+//! AVX2 (with BMI1, BMI2, LZCNT and POPCNT). The first query detects the CPU's features
+//! (`cpuid`, and `xgetbv` for the operating system's support of the 256-bit registers) and
+//! every query from then on runs the AVX2 copy where they are present. Both copies perform the
+//! same IEEE operations in the same order (the 4-wide lanes are the same 128-bit operations,
+//! VEX-encoded; the 8-wide box test runs in 256-bit lanes, each doing one 128-bit lane's
+//! operations; no fused multiply-add is enabled), so they return the same bits;
+//! `kernel/tests/cpu.rs` compares them.
 //! Other targets have one copy and [`traversal_simd`] is always [`Simd::Baseline`].
 
 /// An instruction set the traversal can run in.

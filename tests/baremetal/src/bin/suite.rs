@@ -7,9 +7,10 @@
 
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
+use raykernel::bvh8::nodes8_needed;
 use raykernel::grid::GridOptions;
 use raykernel::kdtree::KdOptions;
-use raykernel::{kdtree, Bvh, Bvh4, Grid, KdNode, KdTree, Linear, Node, Node4, I16F16};
+use raykernel::{kdtree, Bvh, Bvh4, Bvh8, Grid, KdNode, KdTree, Linear, Node, Node4, Node8, I16F16};
 use raykernel_baremetal::cases::{self, Bits, Fail, ICO_TRIS};
 use raykernel_baremetal::{exit, golden, known_answers};
 use semihosting::println;
@@ -75,7 +76,7 @@ fn fail_name(f: Fail) -> &'static str {
     }
 }
 
-/// Every builder with leaves of 1, 2, 4 and 8, the 4-wide BVH, the grid and the kd-tree over
+/// Every builder with leaves of 1, 2, 4 and 8, the 4- and 8-wide BVHs, the grid and the kd-tree over
 /// the golden icosphere: validated, and every query the same bits as brute force.
 #[inline(never)]
 fn accelerators_vs_brute_force<S: Bits>() -> Result<(), Fail> {
@@ -100,7 +101,12 @@ fn accelerators_vs_brute_force<S: Bits>() -> Result<(), Fail> {
         .map_err(|_| Fail::Build)?;
     let mut wide = [Node4::<S>::EMPTY; nodes4_needed(ICO_TRIS)];
     let bvh4 = Bvh4::collapse(&bvh, &mut wide).map_err(|_| Fail::Build)?;
+    bvh4.validate().map_err(|_| Fail::Invalid)?;
     cases::same_queries(&bvh4, &linear)?;
+    let mut wide8 = [Node8::<S>::EMPTY; nodes8_needed(ICO_TRIS)];
+    let bvh8 = Bvh8::collapse(&bvh, &mut wide8).map_err(|_| Fail::Build)?;
+    bvh8.validate().map_err(|_| Fail::Invalid)?;
+    cases::same_queries(&bvh8, &linear)?;
 
     let options = GridOptions::default();
     let size = Grid::size_for(&tris, options).map_err(|_| Fail::Build)?;
