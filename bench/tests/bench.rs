@@ -152,6 +152,8 @@ fn bench_writes_a_well_formed_report_csv_json_and_plots() {
     let mut ours = vec![
         "raykernel bvh4 sah f32",
         "raykernel bvh4 sah fixed",
+        "raykernel bvh8 sah f32",
+        "raykernel bvh8 sah fixed",
         "raykernel bvh sah f32",
         "raykernel bvh sah fixed",
         "raykernel bvh sah f32 MT",
@@ -191,12 +193,23 @@ fn bench_writes_a_well_formed_report_csv_json_and_plots() {
                 });
                 assert_eq!(prebuilt, !peer.is_embree(), "{name}");
             }
-            // Interleaved rounds: three of ours each way, and of each peer in this build.
+            // The headline row names the faster wide BVH of this ray set.
+            let headline = report.lines().any(|l| {
+                l.starts_with(&format!("| {scene} | "))
+                    && ["bvh4", "bvh8"]
+                        .iter()
+                        .any(|s| l.contains(&format!("| {rays} | {s} | ")))
+            });
+            assert!(headline, "no headline row for {scene} {rays}");
+            // Interleaved rounds: three of each wide BVH each way, and of each peer in this
+            // build.
             for k in 1..=3 {
-                let ours = "raykernel bvh4 sah f32";
-                assert!(figure(rows, scene, rays, ours, &format!("closest_mrays_round{k}")) > 0.0);
-                let prebuilt = format!("closest_mrays_prebuilt_round{k}");
-                assert!(figure(rows, scene, rays, ours, &prebuilt) > 0.0);
+                for ours in ["raykernel bvh4 sah f32", "raykernel bvh8 sah f32"] {
+                    let name = format!("closest_mrays_round{k}");
+                    assert!(figure(rows, scene, rays, ours, &name) > 0.0);
+                    let prebuilt = format!("closest_mrays_prebuilt_round{k}");
+                    assert!(figure(rows, scene, rays, ours, &prebuilt) > 0.0);
+                }
                 if peers.iter().any(|p| p.is_embree()) {
                     let name = format!("closest_mrays_round{k}");
                     assert!(figure(rows, scene, rays, "Embree 3 HIGH", &name) > 0.0);
