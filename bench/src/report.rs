@@ -353,16 +353,21 @@ fn structure(row: &TraceRow) -> &str {
         .unwrap_or(&row.contender)
 }
 
-/// Ours in the headline: of the wide BVHs from the SAH build, `f32` and watertight, the one
-/// fastest per ray (construction counted) on this ray set.
-fn our_reference<'r>(rows: &'r [TraceRow], scene: &str, kind: RayKind) -> Option<&'r TraceRow> {
+/// Ours in the headline for `mode`: of the wide BVHs from the SAH build (`f32`: with the
+/// watertight test), the one fastest per ray (construction counted) on this ray set.
+fn fastest_wide<'r>(
+    rows: &'r [TraceRow],
+    scene: &str,
+    kind: RayKind,
+    mode: &str,
+) -> Option<&'r TraceRow> {
     rows.iter()
         .filter(|r| {
             r.ours
                 && r.scene == scene
                 && r.rays == kind
-                && r.mode == "f32"
-                && r.test == "watertight"
+                && r.mode == mode
+                && r.test != crate::ours::MT_TEST
                 && r.builder == raykernel::bvh::BuilderKind::default().name()
                 && HEADLINE_STRUCTURES.contains(&r.contender.as_str())
         })
@@ -375,16 +380,15 @@ fn our_reference<'r>(rows: &'r [TraceRow], scene: &str, kind: RayKind) -> Option
         })
 }
 
-/// The same structure as `reference`, in fixed point.
+/// Ours in `f32` in the headline ([`fastest_wide`]).
+fn our_reference<'r>(rows: &'r [TraceRow], scene: &str, kind: RayKind) -> Option<&'r TraceRow> {
+    fastest_wide(rows, scene, kind, "f32")
+}
+
+/// Ours in fixed point in the headline: the faster wide BVH in that mode (which can be the
+/// other structure than in `f32`), compared with `reference`, the `f32` one.
 fn fixed_reference<'r>(rows: &'r [TraceRow], reference: &TraceRow) -> Option<&'r TraceRow> {
-    rows.iter().find(|r| {
-        r.ours
-            && r.scene == reference.scene
-            && r.rays == reference.rays
-            && r.mode == "fixed"
-            && r.contender == reference.contender
-            && r.builder == reference.builder
-    })
+    fastest_wide(rows, &reference.scene, reference.rays, "fixed")
 }
 
 fn ratio(a: f64, b: f64) -> String {
@@ -493,8 +497,9 @@ fn headline_section(s: &mut String, r: &BenchResults) {
          the faster per ray on the ray set (`structure`) of the 4-wide and the 8-wide BVH, \
          both collapsed from the SAH BVH with the triangles permuted into leaf order \
          (`build_in_leaf_order`, in place); ratios are ours per ray ÷ peer: above \
-         1 means ours is faster. `fixed ÷ f32` is the same structure in fixed point per ray, ray \
-         construction included, against `f32`.\n"
+         1 means ours is faster. `fixed ÷ f32` is fixed point per ray, ray construction \
+         included, against `f32`: the faster wide BVH in fixed point (named beside its figure), \
+         which need not be the one of `f32`.\n"
     );
     let mut head =
         "| scene | triangles | rays | structure | raykernel f32 | raykernel f32 pre-built | raykernel fixed | fixed ÷ f32 |"
@@ -518,7 +523,11 @@ fn headline_section(s: &mut String, r: &BenchResults) {
                 structure(ours),
                 ours.closest_mrays,
                 opt(ours.closest_mrays_prebuilt, 2),
-                fixed.map_or("-".into(), |f| format!("{:.2}", f.closest_mrays)),
+                fixed.map_or("-".into(), |f| format!(
+                    "{:.2} ({})",
+                    f.closest_mrays,
+                    structure(f)
+                )),
                 fixed.map_or("-".into(), |f| ratio(f.closest_mrays, ours.closest_mrays))
             );
             for p in &peers {
