@@ -57,9 +57,17 @@ const _: () = assert!(core::mem::size_of::<Node8<f32>>() == 256);
 const _: () = assert!(core::mem::size_of::<Node8<crate::I16F16>>() == 256);
 
 impl<S: Scalar, const W: usize> WideNode<S, W> {
-    /// A placeholder to fill arenas with, e.g. `[Node4::EMPTY; nodes4_needed(N)]`.
+    /// A placeholder to fill arenas with, e.g. `[Node4::EMPTY; nodes4_needed(N)]`. Only the
+    /// widths there are walks for, 4 and 8, compile:
+    ///
+    /// ```compile_fail
+    /// let _ = raykernel::WideNode::<f32, 2>::EMPTY;
+    /// ```
     pub const EMPTY: Self = Self {
-        lo: [[S::ZERO; W]; 3],
+        lo: {
+            assert!(W == 4 || W == 8, "wide BVH nodes have 4 or 8 slots");
+            [[S::ZERO; W]; 3]
+        },
         hi: [[S::ZERO; W]; 3],
         child: [0; W],
         count: [EMPTY_SLOT; W],
