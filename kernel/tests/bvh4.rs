@@ -4,7 +4,7 @@
 //!   planes, flat boxes, intervals);
 //! - `Numerics::slab8` gives each of its eight boxes exactly the decision and entry bits
 //!   `slab4` gives it in its half, in both modes (so `slab`'s in `f32`), on the same kinds of
-//!   cases; where the CPU has AVX, `Numerics::slab8_avx` (256-bit lanes) gives `slab8`'s;
+//!   cases; where the CPU has AVX2, `Numerics::slab8_avx2` (256-bit lanes) gives `slab8`'s;
 //! - why unused slots are masked by their count rather than by an "empty" box: the slab test
 //!   accepts an inverted box for some ray;
 //! - the collapse, for both widths: arena sizes (`wide_nodes_needed` bounds every collapse and
@@ -160,6 +160,25 @@ const TINY_BOXES8: [([f32; 3], [f32; 3]); 8] = [
     ([-T, -T, -T], [T, T, T]),
     ([T, -1.0, -1.0], [1.0, 1.0, 1.0]),
     ([-1.0, T, -1.0], [1.0, 1.0, -T]),
+];
+
+/// One raw unit of fixed point (2^-16): how far its slab test shifts an origin.
+const R: f32 = 1.0 / 65_536.0;
+
+/// [`TINY_COORDS`] for fixed point: origins one raw unit around the planes of
+/// [`RAW_BOXES8`], where its lanes meet `0 · inf = NaN` too.
+const RAW_COORDS: [f32; 5] = [-R, 0.0, R, 2.0 * R, 3.0 * R];
+
+/// [`TINY_BOXES8`] in raw units of fixed point.
+const RAW_BOXES8: [([f32; 3], [f32; 3]); 8] = [
+    ([R, R, R], [1.0, 1.0, 1.0]),
+    ([-1.0, -1.0, -1.0], [-R, -R, -R]),
+    ([2.0 * R, 2.0 * R, 2.0 * R], [1.0, 1.0, 1.0]),
+    ([-1.0, -1.0, -1.0], [-2.0 * R, -2.0 * R, -2.0 * R]),
+    ([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]),
+    ([-R, -R, -R], [R, R, R]),
+    ([R, -1.0, -1.0], [1.0, 1.0, 1.0]),
+    ([-1.0, R, -1.0], [1.0, 1.0, -R]),
 ];
 
 /// The first four [`TINY_BOXES8`].
@@ -331,18 +350,18 @@ fn slab8_equals_slab4_per_half_fixed() {
         .assert_both_above(1000);
 }
 
-/// `slab8_avx` (for `f32` the eight boxes in the 256-bit lanes of one AVX vector) gives every
-/// box exactly `slab8`'s decision and entry.
+/// `slab8_avx2` (the eight boxes in the 256-bit lanes of one AVX2 vector, in both modes) gives
+/// every box exactly `slab8`'s decision and entry.
 #[cfg(target_arch = "x86_64")]
-fn slab8_avx_equals_slab8<S: TestScalar>(cases: impl IntoIterator<Item = (RaySpec, Boxes<S, 8>)>) {
-    assert!(std::is_x86_feature_detected!("avx"));
+fn slab8_avx2_equals_slab8<S: TestScalar>(cases: impl IntoIterator<Item = (RaySpec, Boxes<S, 8>)>) {
+    assert!(std::is_x86_feature_detected!("avx2"));
     let mut outcomes = Outcomes::default();
     for (i, (spec, (lo, hi))) in cases.into_iter().enumerate() {
         let ray = spec.ray::<S>();
         let (t_min, t_max) = (ray.t_min(), ray.t_max());
         let (mask, t) = S::slab8(ray.data(), &lo, &hi, t_min, t_max);
-        // SAFETY: the CPU has AVX (asserted above), the one thing `slab8_avx` requires.
-        let (avx_mask, avx_t) = unsafe { S::slab8_avx(ray.data(), &lo, &hi, t_min, t_max) };
+        // SAFETY: the CPU has AVX2 (asserted above), the one thing `slab8_avx2` requires.
+        let (avx_mask, avx_t) = unsafe { S::slab8_avx2(ray.data(), &lo, &hi, t_min, t_max) };
         let want = decisions(mask, &t);
         assert_eq!(
             decisions(avx_mask, &avx_t),
@@ -356,19 +375,20 @@ fn slab8_avx_equals_slab8<S: TestScalar>(cases: impl IntoIterator<Item = (RaySpe
     outcomes.assert_both_above(1000);
 }
 
-/// Where the CPU has AVX: [`slab8_avx_equals_slab8`] on random and axis cases, both modes.
+/// Where the CPU has AVX2: [`slab8_avx2_equals_slab8`] on random and axis cases, both modes.
 #[test]
-fn slab8_avx_equals_slab8_where_the_cpu_has_avx() {
+fn slab8_avx2_equals_slab8_where_the_cpu_has_avx2() {
     #[cfg(target_arch = "x86_64")]
-    if std::is_x86_feature_detected!("avx") {
-        slab8_avx_equals_slab8::<f32>(random_cases(0xa7c8, 20_000));
-        slab8_avx_equals_slab8::<f32>(axis_cases(AXIS_BOXES8, AXIS_COORDS));
-        slab8_avx_equals_slab8::<f32>(axis_cases(TINY_BOXES8, TINY_COORDS));
-        slab8_avx_equals_slab8::<I16F16>(random_cases(0xa7c8, 20_000));
-        slab8_avx_equals_slab8::<I16F16>(axis_cases(AXIS_BOXES8, AXIS_COORDS));
+    if std::is_x86_feature_detected!("avx2") {
+        slab8_avx2_equals_slab8::<f32>(random_cases(0xa7c8, 20_000));
+        slab8_avx2_equals_slab8::<f32>(axis_cases(AXIS_BOXES8, AXIS_COORDS));
+        slab8_avx2_equals_slab8::<f32>(axis_cases(TINY_BOXES8, TINY_COORDS));
+        slab8_avx2_equals_slab8::<I16F16>(random_cases(0xa7c8, 20_000));
+        slab8_avx2_equals_slab8::<I16F16>(axis_cases(AXIS_BOXES8, AXIS_COORDS));
+        slab8_avx2_equals_slab8::<I16F16>(axis_cases(RAW_BOXES8, RAW_COORDS));
         return;
     }
-    eprintln!("skipped: slab8_avx needs an x86_64 CPU with AVX");
+    eprintln!("skipped: slab8_avx2 needs an x86_64 CPU with AVX2");
 }
 
 /// The reason unused slots are masked by `count`: an inverted box (`lo = +inf`, `hi = -inf`)

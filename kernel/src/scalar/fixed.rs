@@ -506,6 +506,34 @@ impl Numerics for I16F16 {
         (mask, t.map(I16F16))
     }
 
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
+    #[inline(always)]
+    unsafe fn slab8_avx2(
+        r: &FixedRay,
+        lo: &[[Self; 8]; 3],
+        hi: &[[Self; 8]; 3],
+        t_min: Self,
+        t_max: Self,
+    ) -> (u32, [Self; 8]) {
+        let raw = |planes: &[[Self; 8]; 3]| planes.map(|axis| axis.map(|x| x.0));
+        let o_lo = r.o_lo.map(|x| x as i32); // |origin| <= 2^29: the shifted ones fit
+        let o_hi = r.o_hi.map(|x| x as i32);
+        // SAFETY: the caller guarantees AVX2, the features `slab8_avx2_fixed` enables.
+        let (mask, t) = unsafe {
+            super::wide::slab8_avx2_fixed(
+                o_lo,
+                o_hi,
+                r.inv_lanes,
+                &raw(lo),
+                &raw(hi),
+                t_min.0,
+                t_max.0,
+            )
+        };
+        (mask, t.map(I16F16))
+    }
+
     #[inline(always)]
     fn slab_axis(r: &FixedRay, axis: usize, lo: Self, hi: Self) -> (Self, Self) {
         // The same integer steps as one axis of `slab`, clamped into range (monotone).

@@ -866,15 +866,16 @@ impl Numerics for f32 {
     #[cfg(target_arch = "x86_64")]
     #[allow(unsafe_code)]
     #[inline(always)]
-    unsafe fn slab8_avx(
+    unsafe fn slab8_avx2(
         r: &FloatRay,
         lo: &[[f32; 8]; 3],
         hi: &[[f32; 8]; 3],
         t_min: f32,
         t_max: f32,
     ) -> (u32, [f32; 8]) {
-        // SAFETY: the caller guarantees AVX, the one feature `slab8_avx` enables.
-        unsafe { super::wide::slab8_avx(r.o_lo, r.o_hi, r.inv, WIDEN, lo, hi, t_min, t_max) }
+        // SAFETY: the caller guarantees AVX2, which includes AVX, the one feature
+        // `slab8_avx2` enables.
+        unsafe { super::wide::slab8_avx2(r.o_lo, r.o_hi, r.inv, WIDEN, lo, hi, t_min, t_max) }
     }
 
     fn sphere_bounds(center: &[f32; 3], radius: f32) -> ([f32; 3], [f32; 3]) {

@@ -157,16 +157,17 @@ pub(crate) mod sealed {
             let t = core::array::from_fn(|i| if i < 4 { t_low[i % 4] } else { t_high[i % 4] });
             (low | high << 4, t)
         }
-        /// [`Numerics::slab8`], bit for bit, for code compiled with AVX: `f32` tests the eight
-        /// boxes in the 256-bit lanes of one vector (`wide::slab8_avx`), each lane doing the
-        /// operations of `slab4`'s lanes in their order; the default is `slab8`.
+        /// [`Numerics::slab8`], bit for bit, for code that runs on a CPU with AVX2: the eight
+        /// boxes in the 256-bit lanes of one vector (`wide::slab8_avx2` for `f32`,
+        /// `wide::slab8_avx2_fixed` for fixed point), each lane doing the operations of a
+        /// `slab4` lane in their order; the default is `slab8`.
         ///
         /// # Safety
-        /// The CPU must have AVX.
+        /// The CPU must have AVX2.
         #[cfg(target_arch = "x86_64")]
         #[allow(unsafe_code)]
         #[inline(always)]
-        unsafe fn slab8_avx(
+        unsafe fn slab8_avx2(
             ray: &Self::RayData,
             lo: &[[Self; 8]; 3],
             hi: &[[Self; 8]; 3],

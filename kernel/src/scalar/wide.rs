@@ -64,7 +64,7 @@ pub(super) fn slab4(
     (mask, t_near.to_array())
 }
 
-/// [`slab4`] of eight boxes in the 256-bit lanes of AVX: each lane performs the operations of
+/// [`slab4`] of eight boxes in the 256-bit lanes of AVX (`Numerics::slab8_avx2` for `f32`): each lane performs the operations of
 /// one [`slab4`] lane, in its order (`vsubps`, `vmulps`, `vminps`/`vmaxps` with the same operand
 /// order, so the same result when unordered, and an ordered `<=`), so every box gets the bits
 /// [`slab4`] gives it. Bit `i` of the mask is box `i`.
@@ -75,7 +75,7 @@ pub(super) fn slab4(
 #[allow(clippy::too_many_arguments, unsafe_code)]
 #[target_feature(enable = "avx")]
 #[inline]
-pub(super) unsafe fn slab8_avx(
+pub(super) unsafe fn slab8_avx2(
     o_lo: [f32; 4],
     o_hi: [f32; 4],
     inv: [f32; 4],
@@ -117,6 +117,87 @@ pub(super) unsafe fn slab8_avx(
     }
 }
 
+/// [`slab4_fixed`] of eight boxes in the 256-bit lanes of AVX2 (`Numerics::slab8_avx2` for
+/// fixed point): each lane performs the operations of one [`slab4_fixed`] lane in their order
+/// (wrapping `i32` difference, conversion to `f32`, the products, `min`/`max` with the same
+/// operand order, the two scalings, the ordered `<=`, the clamp and the truncation), so every
+/// box gets the bits [`slab4_fixed`] gives it. Bit `i` of the mask is box `i`.
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[allow(clippy::too_many_arguments, unsafe_code)]
+#[target_feature(enable = "avx,avx2")]
+#[inline]
+pub(super) unsafe fn slab8_avx2_fixed(
+    o_lo: [i32; 3],
+    o_hi: [i32; 3],
+    inv: [f32; 3],
+    lo: &[[i32; 8]; 3],
+    hi: &[[i32; 8]; 3],
+    t_min: i32,
+    t_max: i32,
+) -> (u32, [i32; 8]) {
+    use core::arch::x86_64::{
+        __m256i, _mm256_cmp_ps, _mm256_cvtepi32_ps, _mm256_cvttps_epi32, _mm256_loadu_si256,
+        _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_epi32,
+        _mm256_set1_ps, _mm256_storeu_si256, _mm256_sub_epi32, _CMP_LE_OQ,
+    };
+    // SAFETY: AVX2 is present (the caller's guarantee); every load and store is of eight
+    // `i32` inside an `[i32; 8]`.
+    unsafe {
+        let difference = |planes: &[i32; 8], o: i32| {
+            let p = _mm256_loadu_si256(planes.as_ptr().cast::<__m256i>());
+            _mm256_cvtepi32_ps(_mm256_sub_epi32(p, _mm256_set1_epi32(o)))
+        };
+        let mut t_near = _mm256_set1_ps(t_min as f32);
+        let mut t_far = _mm256_set1_ps(t_max as f32 + 2.0);
+        for k in 0..3 {
+            let k = k.min(2); // a no-op that shows the compiler the bound
+            let inv = _mm256_set1_ps(inv[k]);
+            let a = _mm256_mul_ps(difference(&lo[k], o_lo[k]), inv);
+            let b = _mm256_mul_ps(difference(&hi[k], o_hi[k]), inv);
+            // `enter_exit`'s folds: `near.max(acc)`, `far.min(acc)`, x first.
+            t_near = _mm256_max_ps(_mm256_min_ps(a, b), t_near);
+            t_far = _mm256_min_ps(_mm256_max_ps(a, b), t_far);
+        }
+        let t_near = _mm256_mul_ps(t_near, _mm256_set1_ps(FIXED_SHRINK));
+        let grown = _mm256_mul_ps(t_far, _mm256_set1_ps(FIXED_GROW));
+        let inside = _mm256_cmp_ps::<_CMP_LE_OQ>(t_near, grown);
+        // `clamped_trunc`: `max(x, 0)`, then `min(.., top)`, then truncation.
+        let clamped = _mm256_min_ps(
+            _mm256_max_ps(t_near, _mm256_set1_ps(0.0)),
+            _mm256_set1_ps(FIXED_ENTRY_TOP),
+        );
+        let mut t = [0i32; 8];
+        _mm256_storeu_si256(
+            t.as_mut_ptr().cast::<__m256i>(),
+            _mm256_cvttps_epi32(clamped),
+        );
+        (_mm256_movemask_ps(inside) as u32, t)
+    }
+}
+
+/// [`slab4_fixed`]'s scaling of the entry (`1 - 2^-20`).
+#[cfg(any(
+    target_feature = "sse2",
+    all(target_arch = "aarch64", target_feature = "neon")
+))]
+const FIXED_SHRINK: f32 = 1.0 - 1.0 / 1_048_576.0;
+/// [`slab4_fixed`]'s scaling of the exit (`1 + 2^-20`).
+#[cfg(any(
+    target_feature = "sse2",
+    all(target_arch = "aarch64", target_feature = "neon")
+))]
+const FIXED_GROW: f32 = 1.0 + 1.0 / 1_048_576.0;
+/// The largest `f32` below 2^31: [`slab4_fixed`] clamps entries to it before conversion to raw
+/// `i32`.
+#[cfg(any(
+    target_feature = "sse2",
+    all(target_arch = "aarch64", target_feature = "neon")
+))]
+const FIXED_ENTRY_TOP: f32 = 2_147_483_520.0;
+
 /// `Numerics::slab4` for fixed point where [`F4`] has vector lanes: the four boxes' raw Q16.16
 /// planes against the ray's shifted raw origins `o_lo`, `o_hi` (see `FixedRay`), with `inv`
 /// the reciprocal direction `2^30 / dir` rounded to `f32`; distances in raw Q16.16 units.
@@ -153,10 +234,6 @@ pub(super) fn slab4_fixed(
     t_min: i32,
     t_max: i32,
 ) -> (u32, [i32; 4]) {
-    const SHRINK: f32 = 1.0 - 1.0 / 1_048_576.0;
-    const GROW: f32 = 1.0 + 1.0 / 1_048_576.0;
-    // The largest `f32` below 2^31: entries are clamped to it before conversion to raw `i32`.
-    const ENTRY_TOP: f32 = 2_147_483_520.0;
     let axis = |k: usize| {
         let k = k.min(2); // a no-op that shows the compiler the bound
         let inv = F4::splat(inv[k]);
@@ -166,9 +243,9 @@ pub(super) fn slab4_fixed(
         (a, b)
     };
     let (t_near, t_far) = enter_exit(axis, t_min as f32, t_max as f32 + 2.0);
-    let t_near = t_near.mul(F4::splat(SHRINK));
-    let mask = t_near.le_mask(t_far.mul(F4::splat(GROW)));
+    let t_near = t_near.mul(F4::splat(FIXED_SHRINK));
+    let mask = t_near.le_mask(t_far.mul(F4::splat(FIXED_GROW)));
     // Accepted entries lie in [0, 2^31]: truncation is a floor there.
-    let t = t_near.clamped_trunc(ENTRY_TOP);
+    let t = t_near.clamped_trunc(FIXED_ENTRY_TOP);
     (mask, t.map(|x| x as i32))
 }

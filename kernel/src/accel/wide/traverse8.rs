@@ -1,6 +1,6 @@
 //! Stack-based traversal of the 8-wide tree, nearest child first. One routine serves closest
 //! hit and any hit. The eight boxes of a node are tested in two 4-lane halves
-//! (`Numerics::slab8`), or in the 256-bit lanes of one AVX vector (`Numerics::slab8_avx`)
+//! (`Numerics::slab8`), or in the 256-bit lanes of one AVX2 vector (`Numerics::slab8_avx2`)
 //! where the CPU has it: the same bits either way.
 
 use super::traverse::{pop_in_reach, Walk};
@@ -40,14 +40,14 @@ impl<S: Scalar, P: Primitive<S>> Walk<S> for Bvh8<'_, S, P> {
 }
 
 impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
-    /// [`Bvh8::walk8`] as compiled for the target (in 256-bit lanes if the target has AVX).
+    /// [`Bvh8::walk8`] as compiled for the target (in 256-bit lanes if the target has AVX2).
     #[inline(never)]
     fn walk8_baseline<const ANY: bool, C: Counters>(
         &self,
         ray: &Ray<S>,
         stats: &mut C,
     ) -> (S, u32, usize) {
-        self.walk8::<ANY, C, { cfg!(all(target_arch = "x86_64", target_feature = "avx")) }>(
+        self.walk8::<ANY, C, { cfg!(all(target_arch = "x86_64", target_feature = "avx2")) }>(
             ray, stats,
         )
     }
@@ -68,7 +68,7 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
     }
 
     /// The traversal itself, inlined into each compiled copy. `AVX`: test the boxes with
-    /// `Numerics::slab8_avx`; set only in copies that run on a CPU with AVX.
+    /// `Numerics::slab8_avx2`; set only in copies that run on a CPU with AVX2.
     #[inline(always)]
     fn walk8<const ANY: bool, C: Counters, const AVX: bool>(
         &self,
@@ -96,9 +96,9 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
                     #[cfg(target_arch = "x86_64")]
                     let (hit, t) = if AVX {
                         #[allow(unsafe_code)]
-                        // SAFETY: `AVX` is set only in copies that run on a CPU with AVX.
+                        // SAFETY: `AVX` is set only in copies that run on a CPU with AVX2.
                         unsafe {
-                            S::slab8_avx(rd, &node.lo, &node.hi, t_min, best.0)
+                            S::slab8_avx2(rd, &node.lo, &node.hi, t_min, best.0)
                         }
                     } else {
                         S::slab8(rd, &node.lo, &node.hi, t_min, best.0)
