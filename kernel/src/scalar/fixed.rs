@@ -491,15 +491,13 @@ impl Numerics for I16F16 {
         t_min: Self,
         t_max: Self,
     ) -> (u32, [Self; 4]) {
-        let raw = |planes: &[[Self; 4]; 3]| planes.map(|axis| axis.map(|x| x.0));
-        let o_lo = r.o_lo.map(|x| x as i32); // |origin| <= 2^29: the shifted ones fit
-        let o_hi = r.o_hi.map(|x| x as i32);
+        let (o_lo, o_hi) = r.raw_shifted_origins();
         let (mask, t) = super::wide::slab4_fixed(
             o_lo,
             o_hi,
             r.inv_lanes,
-            &raw(lo),
-            &raw(hi),
+            &raw_planes(lo),
+            &raw_planes(hi),
             t_min.0,
             t_max.0,
         );
@@ -516,17 +514,15 @@ impl Numerics for I16F16 {
         t_min: Self,
         t_max: Self,
     ) -> (u32, [Self; 8]) {
-        let raw = |planes: &[[Self; 8]; 3]| planes.map(|axis| axis.map(|x| x.0));
-        let o_lo = r.o_lo.map(|x| x as i32); // |origin| <= 2^29: the shifted ones fit
-        let o_hi = r.o_hi.map(|x| x as i32);
+        let (o_lo, o_hi) = r.raw_shifted_origins();
         // SAFETY: the caller guarantees AVX2, the features `slab8_avx2_fixed` enables.
         let (mask, t) = unsafe {
             super::wide::slab8_avx2_fixed(
                 o_lo,
                 o_hi,
                 r.inv_lanes,
-                &raw(lo),
-                &raw(hi),
+                &raw_planes(lo),
+                &raw_planes(hi),
                 t_min.0,
                 t_max.0,
             )
@@ -627,6 +623,29 @@ impl Numerics for I16F16 {
 
     fn sphere_bounds(center: &[Self; 3], radius: Self) -> ([Self; 3], [Self; 3]) {
         (center.map(|c| c - radius), center.map(|c| c + radius))
+    }
+}
+
+/// A wide node's planes as raw Q16.16 integers, for the lane box tests.
+#[cfg(any(
+    target_feature = "sse2",
+    all(target_arch = "aarch64", target_feature = "neon")
+))]
+#[inline(always)]
+fn raw_planes<const N: usize>(planes: &[[I16F16; N]; 3]) -> [[i32; N]; 3] {
+    planes.map(|axis| axis.map(|x| x.0))
+}
+
+#[cfg(any(
+    target_feature = "sse2",
+    all(target_arch = "aarch64", target_feature = "neon")
+))]
+impl FixedRay {
+    /// The shifted origins as raw `i32` (`|origin| <= 2^29`, so the shifted ones fit), for
+    /// the lane box tests.
+    #[inline(always)]
+    fn raw_shifted_origins(&self) -> ([i32; 3], [i32; 3]) {
+        (self.o_lo.map(|x| x as i32), self.o_hi.map(|x| x as i32))
     }
 }
 
