@@ -9,7 +9,7 @@ use crate::ours::{mrays, RunOptions};
 use crate::workload::{BenchScene, RayKind};
 use host::trace::{median, millis, prepare_rays, trace_closest};
 use raykernel::bvh::{nodes_needed, BuildOptions};
-use raykernel::bvh4::nodes4_needed;
+use raykernel::bvh4::{collapse_words_needed, nodes4_needed};
 use raykernel::{Bvh, Bvh4, Node, Node4, Scalar, Triangle, I16F16};
 use serde::Serialize;
 use std::time::Instant;
@@ -137,9 +137,10 @@ fn measure<S: Scalar>(
         let mut nodes = vec![Node::<S>::EMPTY; nodes_needed(n)];
         let mut ids = vec![0u32; n];
         let mut nodes4 = vec![Node4::<S>::EMPTY; nodes4_needed(n)];
+        let mut scratch = vec![0u32; collapse_words_needed(n, 4)];
         let start = Instant::now();
         let bvh = Bvh::build(after, &mut nodes, &mut ids, options).map_err(build_error)?;
-        let wide = Bvh4::collapse(&bvh, &mut nodes4).map_err(build_error)?;
+        let wide = Bvh4::collapse(&bvh, &mut nodes4, &mut scratch).map_err(build_error)?;
         rebuild_ms.push(millis(start));
         let (hits, ms) = trace_closest(&wide, &prepared);
         rebuilt_hits = hits;
@@ -150,9 +151,10 @@ fn measure<S: Scalar>(
     let mut nodes = vec![Node::<S>::EMPTY; nodes_needed(n)];
     let mut ids = vec![0u32; n];
     let mut nodes4 = vec![Node4::<S>::EMPTY; nodes4_needed(n)];
+    let mut scratch = vec![0u32; collapse_words_needed(n, 4)];
     let bvh = Bvh::build(before, &mut nodes, &mut ids, options).map_err(build_error)?;
     let (shape, shape4) = {
-        let wide = Bvh4::collapse(&bvh, &mut nodes4).map_err(build_error)?;
+        let wide = Bvh4::collapse(&bvh, &mut nodes4, &mut scratch).map_err(build_error)?;
         (bvh.shape(), wide.shape())
     };
     let mut refit_bvh_ms = Vec::new();

@@ -20,7 +20,7 @@ use core::ffi::{c_char, c_void};
 use core::mem::{align_of, size_of};
 use raykernel::baked::{read_header, BakedMode, BakedScalar};
 use raykernel::bvh::{nodes_needed, BuildOptions, TreeShape, MAX_LEAF_SIZE};
-use raykernel::bvh4::nodes4_needed;
+use raykernel::bvh4::{collapse_words_needed, nodes4_needed};
 use raykernel::{
     Accel, BakeError, Baked, Bvh, Bvh4, Hit, Node, Node4, Primitive, Ray, Scalar, Triangle, I16F16,
 };
@@ -153,6 +153,9 @@ struct Arrays {
     ids: *mut u32,
     nodes: *mut u8,
     nodes4: *mut u8,
+    /// Build scratch, `scratch_words` words (only the build reads it).
+    scratch: *mut u32,
+    scratch_words: usize,
     count: usize,
     shape: TreeShape,
 }
@@ -245,6 +248,9 @@ struct BuildLayout {
     ids: usize,
     nodes: usize,
     nodes4: usize,
+    /// The 4-wide collapse's scratch words ([`collapse_words_needed`]; none for the BVH).
+    scratch: usize,
+    scratch_words: usize,
     end: usize,
 }
 
@@ -257,20 +263,23 @@ fn build_layout(mode: u32, kind: u32, count: usize) -> Option<BuildLayout> {
     let ids = count.checked_mul(size_of::<Triangle<f32>>())?;
     let nodes = up(ids.checked_add(count.checked_mul(4)?)?, 128)?;
     let nodes_end = nodes.checked_add(nodes_needed(count).checked_mul(size_of::<Node<f32>>())?)?;
-    let (nodes4, end) = match kind {
-        RK_KIND_BVH => (nodes_end, nodes_end),
+    let (nodes4, scratch, scratch_words) = match kind {
+        RK_KIND_BVH => (nodes_end, nodes_end, 0),
         RK_KIND_BVH4 => {
             let at = up(nodes_end, 128)?;
             let len = nodes4_needed(count).checked_mul(size_of::<Node4<f32>>())?;
-            (at, at.checked_add(len)?)
+            (at, at.checked_add(len)?, collapse_words_needed(count, 4))
         }
         _ => return None,
     };
+    let end = scratch.checked_add(scratch_words.checked_mul(4)?)?;
     Some(BuildLayout {
         tris,
         ids,
         nodes,
         nodes4,
+        scratch,
+        scratch_words,
         end,
     })
 }
@@ -334,12 +343,14 @@ pub unsafe extern "C" fn rk_build(
         start
     };
     let arrays = Arrays {
-        // SAFETY (all four): offsets within the zeroed region, aligned (128-aligned start,
+        // SAFETY (all five): offsets within the zeroed region, aligned (128-aligned start,
         // offsets multiples of the types' alignments).
         tris: unsafe { start.add(layout.tris) },
         ids: unsafe { start.add(layout.ids) }.cast(),
         nodes: unsafe { start.add(layout.nodes) },
         nodes4: unsafe { start.add(layout.nodes4) },
+        scratch: unsafe { start.add(layout.scratch) }.cast(),
+        scratch_words: layout.scratch_words,
         count,
         shape: TreeShape {
             node_count: 0,
@@ -429,7 +440,9 @@ fn build_in<S: BakedScalar>(
         arrays.shape = bvh.shape();
         return Ok((Baked::Bvh(bvh), arrays));
     }
-    let wide = Bvh4::collapse(&bvh, nodes4).map_err(|_| RkStatus::ErrTooLarge)?;
+    // SAFETY: as for `slices`: zeroed, aligned words of the layout, borrowed nowhere else.
+    let scratch = unsafe { core::slice::from_raw_parts_mut(arrays.scratch, arrays.scratch_words) };
+    let wide = Bvh4::collapse(&bvh, nodes4, scratch).map_err(|_| RkStatus::ErrTooLarge)?;
     arrays.shape = wide.shape();
     Ok((Baked::Bvh4(wide), arrays))
 }

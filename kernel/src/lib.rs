@@ -89,12 +89,14 @@ pub mod baked {
 
 /// Memory size and node slots of the 4-wide BVH, [`Bvh4`].
 pub mod bvh4 {
-    pub use crate::accel::wide::{nodes4_needed, ChildSlot};
+    pub use crate::accel::wide::{collapse_words_needed, nodes4_needed, ChildSlot};
 }
 
 /// Memory size and node slots of the 8-wide BVH, [`Bvh8`], and of wide trees in general.
 pub mod bvh8 {
-    pub use crate::accel::wide::{nodes8_needed, wide_nodes_needed, ChildSlot};
+    pub use crate::accel::wide::{
+        collapse_words_needed, nodes8_needed, wide_nodes_needed, ChildSlot,
+    };
 }
 
 /// Settings, memory sizes and limits of the uniform grid, [`Grid`].

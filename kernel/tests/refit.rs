@@ -9,7 +9,7 @@ use common::{query, same_hit, TestScalar};
 use proptest::prelude::*;
 use raykernel::bvh::{nodes_needed, BuildOptions, RefitError};
 use raykernel::bvh4::nodes4_needed;
-use raykernel::bvh8::nodes8_needed;
+use raykernel::bvh8::{collapse_words_needed, nodes8_needed};
 use raykernel::{Bvh, Bvh4, Bvh8, Linear, Node, Node4, Node8, Ray, Triangle, I16F16};
 use raykernel_testkit::icosphere::unit_icosphere;
 use raykernel_testkit::Rng;
@@ -85,8 +85,9 @@ fn check_refit<S: TestScalar>(
             Bvh::build(&tris, &mut nodes, &mut ids, options)
         }
         .map_err(|e| e.to_string())?;
-        let wide4 = Bvh4::collapse(&bvh, &mut nodes4).map_err(|e| e.to_string())?;
-        let wide8 = Bvh8::collapse(&bvh, &mut nodes8).map_err(|e| e.to_string())?;
+        let mut scratch = vec![0u32; collapse_words_needed(n, 8)];
+        let wide4 = Bvh4::collapse(&bvh, &mut nodes4, &mut scratch).map_err(|e| e.to_string())?;
+        let wide8 = Bvh8::collapse(&bvh, &mut nodes8, &mut scratch).map_err(|e| e.to_string())?;
         (bvh.shape(), wide4.shape(), wide8.shape())
     };
     // Move: triangle with id `id` takes `after[id]`, wherever it sits.

@@ -1078,11 +1078,12 @@ fn buffers_and_tiles_are_checked_exactly() {
         },
     };
     // Two objects of two triangles: BVH 2·(2n) nodes and n ids, each wide BVH one wide node
-    // each besides, kd-tree 4n+1 nodes and 6n refs; and for every structure the top-level BVH
-    // over the two objects, 4 nodes and 2 ids.
+    // and its collapse's scratch, W - 1 words per BVH node, each besides, kd-tree 4n+1 nodes
+    // and 6n refs; and for every structure the top-level BVH over the two objects, 4 nodes and
+    // 2 ids.
     assert_eq!(bvh_need, need(8 + 4, 0, 0, 0, 4 + 2));
-    assert_eq!(bvh4_need, need(8 + 4, 2, 0, 0, 4 + 2));
-    assert_eq!(bvh8_need, need(8 + 4, 0, 2, 0, 4 + 2));
+    assert_eq!(bvh4_need, need(8 + 4, 2, 0, 0, 4 + 2 * 3 * 4 + 2));
+    assert_eq!(bvh8_need, need(8 + 4, 0, 2, 0, 4 + 2 * 7 * 4 + 2));
     assert_eq!(kd_need, need(4, 0, 0, 18, 24 + 2));
     let g = grid_need.accel;
     assert_eq!((g.nodes, g.nodes4, g.nodes8, g.kd_nodes), (4, 0, 0, 0));

@@ -8,7 +8,7 @@ use super::family::{
 use super::grid::{Grid, InvalidGrid};
 use super::kdtree::{InvalidKdTree, KdTree};
 use super::memory::take;
-use super::wide::{Bvh4, Bvh8};
+use super::wide::{collapse_words_needed, Bvh4, Bvh8};
 use super::{Accel, AccelKind, AccelMemory, BuildError, Counters, Linear, MemoryNeeded, Nearest};
 use crate::geom::{Barycentrics, Primitive, Ray};
 use crate::scalar::Scalar;
@@ -66,7 +66,7 @@ impl<'a, S: Scalar, P: Primitive<S>> AnyAccel<'a, S, P> {
     where
         P: Copy,
     {
-        let need = MemoryNeeded::bvh4(prims.len());
+        let need = MemoryNeeded::bvh(prims.len());
         match kind {
             AccelKind::Bvh(options) => {
                 let nodes = take(&mut memory.nodes, need.nodes);
@@ -77,16 +77,18 @@ impl<'a, S: Scalar, P: Primitive<S>> AnyAccel<'a, S, P> {
             AccelKind::Bvh4(options) => {
                 let nodes = take(&mut memory.nodes, need.nodes);
                 let ids = take(&mut memory.words, need.words);
-                let nodes4 = take(&mut memory.nodes4, need.nodes4);
+                let nodes4 = take(&mut memory.nodes4, MemoryNeeded::bvh4(prims.len()).nodes4);
+                let scratch = take(&mut memory.words, collapse_words_needed(prims.len(), 4));
                 let binary = Bvh::build_in_leaf_order(prims, nodes, ids, options)?;
-                Ok(Self::Bvh4(Bvh4::collapse(&binary, nodes4)?))
+                Ok(Self::Bvh4(Bvh4::collapse(&binary, nodes4, scratch)?))
             }
             AccelKind::Bvh8(options) => {
                 let nodes = take(&mut memory.nodes, need.nodes);
                 let ids = take(&mut memory.words, need.words);
                 let nodes8 = take(&mut memory.nodes8, MemoryNeeded::bvh8(prims.len()).nodes8);
+                let scratch = take(&mut memory.words, collapse_words_needed(prims.len(), 8));
                 let binary = Bvh::build_in_leaf_order(prims, nodes, ids, options)?;
-                Ok(Self::Bvh8(Bvh8::collapse(&binary, nodes8)?))
+                Ok(Self::Bvh8(Bvh8::collapse(&binary, nodes8, scratch)?))
             }
             AccelKind::Linear | AccelKind::Grid(_) | AccelKind::KdTree(_) => {
                 Self::build(kind, prims, memory)

@@ -15,6 +15,8 @@ pub enum Arena {
     Cells,
     /// The uniform grid's or kd-tree's primitive-reference slice.
     Refs,
+    /// Build scratch words (the wide BVHs' collapse cost table).
+    Scratch,
 }
 
 /// Why an acceleration structure could not be built.

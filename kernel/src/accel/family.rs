@@ -6,7 +6,7 @@ use super::bvh::{BuildOptions, BuildSettings, Bvh};
 use super::grid::{Grid, GridOptions};
 use super::kdtree::{KdOptions, KdTree};
 use super::memory::take;
-use super::wide::{Bvh4, Bvh8};
+use super::wide::{collapse_words_needed, Bvh4, Bvh8};
 use super::{
     check_count, check_each, Accel, AccelKind, AccelMemory, BuildError, Linear, MemoryNeeded,
 };
@@ -181,7 +181,9 @@ impl<S: Scalar> AccelFamily<S> for Bvh4Family {
         memory: &mut AccelMemory<'a, S>,
     ) -> Result<Bvh4<'a, S, P>, BuildError> {
         let nodes4 = take(&mut memory.nodes4, MemoryNeeded::bvh4(prims.len()).nodes4);
-        Bvh4::collapse(&binary_in(options, prims, memory)?, nodes4)
+        let binary = binary_in(options, prims, memory)?;
+        let scratch = take(&mut memory.words, collapse_words_needed(prims.len(), 4));
+        Bvh4::collapse(&binary, nodes4, scratch)
     }
 }
 
@@ -204,7 +206,9 @@ impl<S: Scalar> AccelFamily<S> for Bvh8Family {
         memory: &mut AccelMemory<'a, S>,
     ) -> Result<Bvh8<'a, S, P>, BuildError> {
         let nodes8 = take(&mut memory.nodes8, MemoryNeeded::bvh8(prims.len()).nodes8);
-        Bvh8::collapse(&binary_in(options, prims, memory)?, nodes8)
+        let binary = binary_in(options, prims, memory)?;
+        let scratch = take(&mut memory.words, collapse_words_needed(prims.len(), 8));
+        Bvh8::collapse(&binary, nodes8, scratch)
     }
 }
 

@@ -3,7 +3,7 @@
 use super::bvh::{nodes_needed, Node};
 use super::grid::GridSize;
 use super::kdtree::{self, KdNode};
-use super::wide::{nodes4_needed, nodes8_needed, Node4, Node8};
+use super::wide::{collapse_words_needed, nodes4_needed, nodes8_needed, Node4, Node8};
 use crate::scalar::Scalar;
 
 /// Memory for accelerator builds: one buffer per element type. A build takes its share from
@@ -19,7 +19,8 @@ pub struct AccelMemory<'a, S: Scalar> {
     pub nodes8: &'a mut [Node8<S>],
     /// Kd-tree nodes.
     pub kd_nodes: &'a mut [KdNode<S>],
-    /// Index words: BVH primitive ids, grid cell offsets and references, kd-tree references.
+    /// Index words: BVH primitive ids, grid cell offsets and references, kd-tree references,
+    /// and the wide BVHs' collapse scratch.
     pub words: &'a mut [u32],
 }
 
@@ -108,22 +109,25 @@ impl MemoryNeeded {
         }
     }
 
-    /// A 4-wide BVH over `count` primitives: the binary BVH it is collapsed from (its nodes
-    /// are build scratch) and [`nodes4_needed`] wide nodes.
+    /// A 4-wide BVH over `count` primitives: the binary BVH it is collapsed from, then the
+    /// collapse's scratch words after the primitive ids (build scratch both), and
+    /// [`nodes4_needed`] wide nodes.
     #[must_use]
     pub const fn bvh4(count: usize) -> Self {
         Self {
             nodes4: nodes4_needed(count),
+            words: count + collapse_words_needed(count, 4),
             ..Self::bvh(count)
         }
     }
 
-    /// An 8-wide BVH over `count` primitives: the binary BVH it is collapsed from (its nodes
-    /// are build scratch) and [`nodes8_needed`] wide nodes.
+    /// An 8-wide BVH over `count` primitives: as [`MemoryNeeded::bvh4`], with
+    /// [`nodes8_needed`] wide nodes.
     #[must_use]
     pub const fn bvh8(count: usize) -> Self {
         Self {
             nodes8: nodes8_needed(count),
+            words: count + collapse_words_needed(count, 8),
             ..Self::bvh(count)
         }
     }

@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind, InvalidTree, TreeStats};
-use raykernel::bvh8::wide_nodes_needed;
+use raykernel::bvh8::{collapse_words_needed, wide_nodes_needed};
 use raykernel::{
     grid::GridOptions, kdtree, kdtree::KdOptions, Accel, AccelKind, AnyAccel, Bvh, Bvh4, Bvh8,
     Grid, Hit, KdNode, KdTree, Node, PointError, Primitive, Ray, Scalar, WideBvh, WideNode,
@@ -215,7 +215,7 @@ where
 }
 
 /// Collapses `bvh` into a `W`-wide BVH in an arena of exactly
-/// [`wide_nodes_needed`]`(n, W)` slots and hands it to `f` (validation is the caller's).
+/// [`wide_nodes_needed`]`(n, W)` slots (and [`collapse_words_needed`] scratch words) and hands it to `f` (validation is the caller's).
 pub fn with_wide<const W: usize, S, P, R>(
     bvh: &Bvh<'_, S, P>,
     f: impl FnOnce(&WideBvh<'_, S, P, W>) -> R,
@@ -224,8 +224,10 @@ where
     S: Scalar,
     P: Primitive<S>,
 {
-    let mut nodes = vec![WideNode::<S, W>::EMPTY; wide_nodes_needed(bvh.prims().len(), W)];
-    let wide = WideBvh::collapse(bvh, &mut nodes).unwrap_or_else(|e| {
+    let n = bvh.prims().len();
+    let mut nodes = vec![WideNode::<S, W>::EMPTY; wide_nodes_needed(n, W)];
+    let mut scratch = vec![0u32; collapse_words_needed(n, W)];
+    let wide = WideBvh::collapse(bvh, &mut nodes, &mut scratch).unwrap_or_else(|e| {
         panic!(
             "{} {W}-wide collapse ({} prims) failed: {e}",
             S::NAME,

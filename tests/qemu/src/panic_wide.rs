@@ -6,7 +6,7 @@
 
 use core::hint::black_box;
 use raykernel::bvh::{nodes_needed, BuildOptions};
-use raykernel::bvh8::wide_nodes_needed;
+use raykernel::bvh8::{collapse_words_needed, wide_nodes_needed};
 use raykernel::{
     Accel, Bvh, Node, Primitive, Ray, Scalar, Sphere, TraversalStats, Triangle, WideBvh, WideNode,
 };
@@ -35,7 +35,8 @@ pub fn exercise<const W: usize, S: Scalar, P: Primitive<S>>(
     let Ok(bvh) = Bvh::build(prims, &mut nodes, &mut ids, options) else {
         return;
     };
-    if let Ok(tree) = WideBvh::collapse(&bvh, &mut wide[..used]) {
+    let mut scratch = [0u32; collapse_words_needed(N, 8)];
+    if let Ok(tree) = WideBvh::collapse(&bvh, &mut wide[..used], &mut scratch) {
         black_box(tree.intersect(&ray));
         black_box(tree.occluded(&ray));
         black_box(tree.intersect_counted(&ray, &mut stats));

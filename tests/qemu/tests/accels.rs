@@ -12,7 +12,7 @@ use defmt_semihosting as _; // global logger: defmt frames to semihosting stdout
 use panic_probe as _; // prints the panic via defmt, then `udf` -> HardFault
 
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
-use raykernel::bvh8::wide_nodes_needed;
+use raykernel::bvh8::{collapse_words_needed, wide_nodes_needed};
 use raykernel::{
     grid::GridOptions, kdtree, kdtree::KdOptions, Accel, Bvh, Grid, KdNode, KdTree, Linear, Node,
     Scalar, Triangle, WideBvh, WideNode,
@@ -170,6 +170,7 @@ where
     defmt::assert_eq!(arena.len(), needed);
     let mut nodes = [Node::<S>::EMPTY; nodes_needed(WIDE_TRIS)];
     let mut ids = [0u32; WIDE_TRIS];
+    let mut scratch = [0u32; collapse_words_needed(WIDE_TRIS, 8)];
     for builder in BuilderKind::ALL {
         let options = BuildOptions {
             builder,
@@ -180,7 +181,7 @@ where
         let Ok(bvh) = bvh else {
             defmt::panic!("{} build", S::NAME)
         };
-        let tree = WideBvh::collapse(&bvh, &mut *arena);
+        let tree = WideBvh::collapse(&bvh, &mut *arena, &mut scratch);
         let Ok(tree) = tree else {
             defmt::panic!("{=usize}-wide {} collapse", W, S::NAME)
         };
@@ -200,7 +201,7 @@ where
     let Ok(bvh) = bvh else {
         defmt::panic!("{} leaf-order build", S::NAME)
     };
-    match WideBvh::collapse(&bvh, &mut *arena) {
+    match WideBvh::collapse(&bvh, &mut *arena, &mut scratch) {
         Ok(tree) => {
             defmt::assert!(tree.check().is_ok() && tree.is_leaf_order());
             if let Err(e) = cases::same_queries(&tree, &linear) {
@@ -209,7 +210,7 @@ where
         }
         Err(_) => defmt::panic!("{=usize}-wide {} leaf-order collapse", W, S::NAME),
     }
-    let e = WideBvh::collapse(&bvh, &mut arena[..needed - 1]).err();
+    let e = WideBvh::collapse(&bvh, &mut arena[..needed - 1], &mut scratch).err();
     defmt::assert!(
         e == Some(raykernel::BuildError::ArenaTooSmall {
             arena: raykernel::Arena::Nodes,

@@ -4,17 +4,24 @@
 //! Each [`WideNode`] holds the boxes of up to four (eight) children side by side, so traversal
 //! tests them at once (one vector lane per child, `Numerics::slab4`, twice for eight children
 //! or once in 256-bit lanes where the CPU has AVX) and visits the hit children nearest first.
-//! The collapse is the standard one (e.g. Wald et al. 2008, "Getting rid of packets"; Áfra et
-//! al. 2016 for the collapse order): a wide node starts from a BVH2 inner node's two children
-//! and repeatedly opens the inner child with the largest surface area, replacing it by its two
-//! children, until it has four (eight) children or none is inner. BVH2 leaves become leaf children as they are, referencing the
-//! same `prim_ids` ranges, so a wide tree borrows the primitive ids and primitives of the
-//! [`Bvh`] it came from (leaf order included). The BVH2 node arena is only build scratch:
-//! once collapsed, queries read the wide node arena, the ids and the primitives.
 //!
-//! [`WideBvh::collapse`] is iterative and needs no stack: wide nodes are laid out breadth-first
-//! and the arena itself is the work queue (a node still to fill holds its BVH2 source). Every
-//! box is the BVH2 node's box bit for bit, and every query returns exactly what [`Bvh`] and
+//! The collapse chooses which BVH2 nodes become wide nodes and which small subtrees become
+//! leaves (of at most as many primitives as the BVH2's largest leaf) by minimising the surface
+//! area heuristic over every such choice, by dynamic programming (Ylitie, Karras and Laine
+//! 2017); its cost table takes `W - 1` scratch words per BVH2 node slot
+//! ([`collapse_words_needed`]). Should that tree not fit the node arena, whose bound
+//! ([`wide_nodes_needed`]) is proved for the greedy collapse, the greedy one is made instead: a
+//! wide node starts from a BVH2 inner node's two children and repeatedly opens the inner child
+//! with the largest surface area until it has four (eight) children or none is inner (Wald et
+//! al. 2008, "Getting rid of packets"). Leaves reference `prim_ids` ranges of the BVH2 (a
+//! subtree's leaves cover one range), so a wide tree borrows the primitive ids and primitives
+//! of the [`Bvh`] it came from (leaf order included). The BVH2 node arena and the scratch
+//! words are only build scratch: once collapsed, queries read the wide node arena, the ids and
+//! the primitives.
+//!
+//! [`WideBvh::collapse`] is iterative: wide nodes are laid out breadth-first and the arena
+//! itself is the work queue (a node still to fill holds its BVH2 source). Every box is a BVH2
+//! node's box bit for bit, and every query returns exactly what [`Bvh`] and
 //! [`crate::Linear`] return.
 
 mod collapse;
@@ -27,7 +34,7 @@ mod validate;
 
 pub use node::{ChildSlot, Node4, Node8, WideNode};
 
-use crate::accel::bvh::Bvh;
+use crate::accel::bvh::{nodes_needed, Bvh};
 use crate::accel::BuildError;
 use crate::geom::Primitive;
 use crate::scalar::Scalar;
@@ -65,6 +72,13 @@ pub const fn wide_nodes_needed(prim_count: usize, width: usize) -> usize {
     }
 }
 
+/// Scratch words [`WideBvh::collapse`] needs for a `width`-wide tree from a BVH over
+/// `prim_count` primitives: `width - 1` per BVH node slot ([`crate::bvh::nodes_needed`]).
+#[must_use]
+pub const fn collapse_words_needed(prim_count: usize, width: usize) -> usize {
+    width.saturating_sub(1) * nodes_needed(prim_count)
+}
+
 /// [`wide_nodes_needed`] for the 4-wide BVH.
 #[must_use]
 pub const fn nodes4_needed(prim_count: usize) -> usize {
@@ -99,16 +113,19 @@ pub type Bvh8<'a, S, P> = WideBvh<'a, S, P, 8>;
 
 impl<'a, S: Scalar, P: Primitive<S>, const W: usize> WideBvh<'a, S, P, W> {
     /// Collapses `bvh` into `nodes` (at least [`wide_nodes_needed`]`(bvh.prims().len(), W)`
-    /// slots).
+    /// slots), with `scratch` for the cost table (at least `W - 1` words per slot of
+    /// [`Bvh::nodes`], which [`collapse_words_needed`] bounds; its contents are overwritten).
     /// Allocation-free, no recursion, deterministic.
     ///
     /// # Errors
-    /// [`BuildError::ArenaTooSmall`] (arena [`crate::Arena::Nodes`]) with the exact bound.
+    /// [`BuildError::ArenaTooSmall`] with the exact bound: arena [`crate::Arena::Nodes`] or
+    /// [`crate::Arena::Scratch`].
     pub fn collapse(
         bvh: &Bvh<'a, S, P>,
         nodes: &'a mut [WideNode<S, W>],
+        scratch: &mut [u32],
     ) -> Result<Self, BuildError> {
-        let (count, depth) = collapse::collapse(bvh.nodes(), nodes, bvh.prims().len())?;
+        let (count, depth) = collapse::collapse(bvh.nodes(), nodes, scratch, bvh.prims().len())?;
         let nodes: &'a [WideNode<S, W>] = nodes;
         Ok(Self {
             nodes: nodes.get(..count).unwrap_or_default(),

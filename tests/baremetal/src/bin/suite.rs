@@ -7,7 +7,7 @@
 
 use raykernel::bvh::{nodes_needed, BuildOptions, BuilderKind};
 use raykernel::bvh4::nodes4_needed;
-use raykernel::bvh8::nodes8_needed;
+use raykernel::bvh8::{collapse_words_needed, nodes8_needed};
 use raykernel::grid::GridOptions;
 use raykernel::kdtree::KdOptions;
 use raykernel::{kdtree, Bvh, Bvh4, Bvh8, Grid, KdNode, KdTree, Linear, Node, Node4, Node8, I16F16};
@@ -99,12 +99,13 @@ fn accelerators_vs_brute_force<S: Bits>() -> Result<(), Fail> {
     }
     let bvh = Bvh::build(&tris, &mut nodes, &mut ids, BuildOptions::default())
         .map_err(|_| Fail::Build)?;
+    let mut scratch = [0u32; collapse_words_needed(ICO_TRIS, 8)];
     let mut wide = [Node4::<S>::EMPTY; nodes4_needed(ICO_TRIS)];
-    let bvh4 = Bvh4::collapse(&bvh, &mut wide).map_err(|_| Fail::Build)?;
+    let bvh4 = Bvh4::collapse(&bvh, &mut wide, &mut scratch).map_err(|_| Fail::Build)?;
     bvh4.validate().map_err(|_| Fail::Invalid)?;
     cases::same_queries(&bvh4, &linear)?;
     let mut wide8 = [Node8::<S>::EMPTY; nodes8_needed(ICO_TRIS)];
-    let bvh8 = Bvh8::collapse(&bvh, &mut wide8).map_err(|_| Fail::Build)?;
+    let bvh8 = Bvh8::collapse(&bvh, &mut wide8, &mut scratch).map_err(|_| Fail::Build)?;
     bvh8.validate().map_err(|_| Fail::Invalid)?;
     cases::same_queries(&bvh8, &linear)?;
 
