@@ -337,11 +337,13 @@ fn range<S: Scalar>(src: &[Node<S>], x: usize) -> (u32, u32) {
 
 #[cfg(test)]
 mod tests {
-    extern crate std;
     use super::*;
-    use crate::accel::bvh::{nodes_needed, BuildOptions, Bvh};
+    use crate::accel::bvh::{nodes_needed, BuildOptions, BuilderKind, Bvh};
     use crate::geom::Triangle;
-    use std::vec::Vec;
+
+    /// Most triangles a test here builds over (its arrays are sized for it: no `std`).
+    const MAX: usize = 300;
+    const NODES: usize = nodes_needed(MAX);
 
     /// SAH cost of a laid-out wide tree under the table's model: the root's box and every
     /// inner child's box times [`NODE_COST`], every leaf child's box times its count.
@@ -351,71 +353,82 @@ mod tests {
             for i in 0..n.child_count() {
                 let (b, slot) = (n.bounds(i).unwrap(), n.slot(i).unwrap());
                 let area = f64::from(half_area(&b.lo, &b.hi));
-                cost += area
-                    * f64::from(if slot.count == 0 {
-                        NODE_COST
-                    } else {
-                        slot.count as f32
-                    });
+                let weight = if slot.count == 0 {
+                    NODE_COST
+                } else {
+                    slot.count as f32
+                };
+                cost += area * f64::from(weight);
             }
         }
         cost
     }
 
-    /// Triangles scattered by a fixed linear congruential sequence, sizes varying by 100×.
-    pub(super) fn soup_seeded(n: usize, seed: u32) -> Vec<Triangle<f32>> {
+    /// `MAX` triangles scattered by a linear congruential sequence from `seed`, sizes
+    /// varying by 100×.
+    fn soup(seed: u32) -> [Triangle<f32>; MAX] {
         let mut state = 12345u32 ^ seed.wrapping_mul(2_654_435_761);
         let mut next = move || {
             state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
             (state >> 8) as f32 / 16_777_216.0
         };
-        (0..n)
-            .map(|_| {
-                let (c, s) = (
-                    [next() * 100.0, next() * 100.0, next() * 10.0],
-                    0.1 + next() * 10.0,
-                );
-                let mut v = |k: f32| [c[0] + s * next() * k, c[1] + s * next(), c[2] + s * next()];
-                Triangle::from_f32([v(1.0), v(-1.0), v(0.5)]).unwrap()
-            })
-            .collect()
+        core::array::from_fn(|_| {
+            let c = [next() * 100.0, next() * 100.0, next() * 10.0];
+            let s = 0.1 + next() * 10.0;
+            let mut v = |k: f32| [c[0] + s * next() * k, c[1] + s * next(), c[2] + s * next()];
+            Triangle::from_f32([v(1.0), v(-1.0), v(0.5)]).unwrap()
+        })
+    }
+
+    /// Builds the binary SAH BVH over the first `n` triangles of `soup(seed)` and the
+    /// `W`-wide cost table over it, and hands both to `f`.
+    fn with_table<const W: usize>(
+        n: usize,
+        seed: u32,
+        max_leaf_size: u32,
+        f: impl FnOnce(&[Node<f32>], &Costs<W>),
+    ) {
+        let tris = soup(seed);
+        let mut nodes = [Node::EMPTY; NODES];
+        let mut ids = [0u32; MAX];
+        let options = BuildOptions {
+            max_leaf_size,
+            ..BuildOptions::default()
+        };
+        let bvh = Bvh::build(&tris[..n], &mut nodes, &mut ids, options).unwrap();
+        let mut words = [u32::MAX; 7 * NODES];
+        let words = &mut words[..(W - 1) * bvh.nodes().len()];
+        f(bvh.nodes(), &Costs::<W>::plan(bvh.nodes(), words));
     }
 
     fn optimal_against_greedy<const W: usize>(max_leaf_size: u32) {
-        for n in [2usize, 7, 40, 300] {
-            let tris = soup_seeded(n, 0);
-            let mut nodes = std::vec![Node::EMPTY; nodes_needed(n)];
-            let mut ids = std::vec![0u32; n];
-            let options = BuildOptions {
-                max_leaf_size,
-                ..BuildOptions::default()
-            };
-            let bvh = Bvh::build(&tris, &mut nodes, &mut ids, options).unwrap();
-            let src = bvh.nodes();
-            let mut words = std::vec![u32::MAX; (W - 1) * src.len()];
-            let costs = Costs::<W>::plan(src, &mut words);
-            let mut out = std::vec![WideNode::<f32, W>::EMPTY; wide_nodes_needed(n, W)];
-            let (used, _) = layout(src, &mut out, |s| costs.roots(src, s)).unwrap();
-            let optimal = sah(&src[0], &out[..used]);
-            let (greedy_used, _) = layout(src, &mut out, |s| greedy_roots(src, s)).unwrap();
-            let greedy = sah(&src[0], &out[..greedy_used]);
-            // The table's root cost is the laid-out tree's (up to the order of additions),
-            // and no greater than the greedy tree's, which is one of the trees it ranges over.
-            let table = f64::from(costs.get(0, 1));
-            assert!(
-                (optimal - table).abs() <= 1e-5 * table,
-                "{W}-wide, n = {n}: {optimal} vs {table}"
-            );
-            assert!(
-                optimal <= greedy * (1.0 + 1e-6),
-                "{W}-wide, n = {n}: {optimal} > {greedy}"
-            );
-            if n == 300 {
+        for n in [2usize, 7, 40, MAX] {
+            with_table::<W>(n, 0, max_leaf_size, |src, costs| {
+                let mut out = [WideNode::<f32, W>::EMPTY; MAX];
+                let out = &mut out[..wide_nodes_needed(n, W)];
+                let (used, _) = layout(src, out, |s| costs.roots(src, s)).unwrap();
+                let optimal = sah(&src[0], &out[..used]);
+                let (greedy_used, _) = layout(src, out, |s| greedy_roots(src, s)).unwrap();
+                let greedy = sah(&src[0], &out[..greedy_used]);
+                // The table's root cost is the laid-out tree's (up to the order of the
+                // additions), and no greater than the greedy tree's, one of those it ranges
+                // over.
+                let table = f64::from(costs.get(0, 1));
                 assert!(
-                    used < greedy_used,
-                    "{W}-wide: {used} nodes, greedy {greedy_used}"
+                    (optimal - table).abs() <= 1e-5 * table,
+                    "{W}-wide, n = {n}: {optimal} vs {table}"
                 );
-            }
+                assert!(
+                    optimal <= greedy * (1.0 + 1e-6),
+                    "{W}-wide, n = {n}: {optimal} > {greedy}"
+                );
+                if n == MAX {
+                    assert!(
+                        used < greedy_used,
+                        "{W}-wide: {used} nodes, greedy {greedy_used}"
+                    );
+                }
+            });
         }
     }
 
@@ -427,36 +440,21 @@ mod tests {
         }
     }
 
-    /// Builds the binary SAH BVH over `soup_seeded(n, seed)` (leaves of one) and the
-    /// `W`-wide cost table over it, and hands both to `f`.
-    fn with_table<const W: usize>(n: usize, seed: u32, f: impl FnOnce(&[Node<f32>], &Costs<W>)) {
-        let tris = soup_seeded(n, seed);
-        let mut nodes = std::vec![Node::EMPTY; nodes_needed(n)];
-        let mut ids = std::vec![0u32; n];
-        let options = BuildOptions {
-            max_leaf_size: 1,
-            ..BuildOptions::default()
-        };
-        let bvh = Bvh::build(&tris, &mut nodes, &mut ids, options).unwrap();
-        let mut words = std::vec![u32::MAX; (W - 1) * bvh.nodes().len()];
-        f(bvh.nodes(), &Costs::<W>::plan(bvh.nodes(), &mut words));
-    }
-
     #[test]
     fn an_optimal_tree_too_large_for_the_arena_gives_way_to_the_greedy_one() {
         // Seed 1, 17 triangles: the optimal 4-wide tree has one node more than the greedy one.
-        with_table::<4>(17, 1, |src, costs| {
-            let mut out = std::vec![WideNode::<f32, 4>::EMPTY; 17];
+        with_table::<4>(17, 1, 1, |src, costs| {
+            let mut out = [WideNode::<f32, 4>::EMPTY; 17];
             let (optimal, _) = layout(src, &mut out, |s| costs.roots(src, s)).unwrap();
             let (greedy, _) = layout(src, &mut out, |s| greedy_roots(src, s)).unwrap();
-            let greedy_tree = out[..greedy].to_vec();
+            let greedy_tree = out;
             assert_eq!((optimal, greedy), (8, 7));
             let fits = lay_out(src, &mut out[..optimal], costs).unwrap();
             assert_eq!(fits.0, optimal);
-            assert_ne!(out[..optimal].to_vec(), greedy_tree[..]);
+            assert_ne!(out[..optimal], greedy_tree[..optimal]);
             let falls_back = lay_out(src, &mut out[..optimal - 1], costs).unwrap();
             assert_eq!(falls_back.0, greedy);
-            assert_eq!(out[..greedy].to_vec(), greedy_tree);
+            assert_eq!(out[..greedy], greedy_tree[..greedy]);
         });
     }
 
@@ -464,29 +462,28 @@ mod tests {
     /// in a row is a full root over `W` nodes of two leaves each. (The optimal one does
     /// better: the root holds leaves and nodes of more than two.)
     fn greedy_reaches_the_bound<const W: usize>() {
-        let tris: Vec<Triangle<f32>> = (0..2 * W)
-            .map(|i| {
-                let x = i as f32 * 2.0;
-                Triangle::from_f32([[x, 0.0, 5.0], [x + 1.0, 0.0, 5.0], [x, 1.0, 5.0]]).unwrap()
-            })
-            .collect();
-        let mut nodes = std::vec![Node::EMPTY; nodes_needed(2 * W)];
-        let mut ids = std::vec![0u32; 2 * W];
+        let row: [Triangle<f32>; 16] = core::array::from_fn(|i| {
+            let x = i as f32 * 2.0;
+            Triangle::from_f32([[x, 0.0, 5.0], [x + 1.0, 0.0, 5.0], [x, 1.0, 5.0]]).unwrap()
+        });
+        let mut nodes = [Node::EMPTY; nodes_needed(16)];
+        let mut ids = [0u32; 16];
         let options = BuildOptions {
-            builder: crate::accel::bvh::BuilderKind::Median,
+            builder: BuilderKind::Median,
             max_leaf_size: 1,
             reinsertion: false,
         };
-        let bvh = Bvh::build(&tris, &mut nodes, &mut ids, options).unwrap();
+        let bvh = Bvh::build(&row[..2 * W], &mut nodes, &mut ids, options).unwrap();
         let src = bvh.nodes();
-        let mut words = std::vec![0u32; (W - 1) * src.len()];
-        let costs = Costs::<W>::plan(src, &mut words);
-        let mut out = std::vec![WideNode::<f32, W>::EMPTY; wide_nodes_needed(2 * W, W)];
+        let mut words = [0u32; 7 * nodes_needed(16)];
+        let costs = Costs::<W>::plan(src, &mut words[..(W - 1) * src.len()]);
+        let mut out = [WideNode::<f32, W>::EMPTY; 16];
+        let out = &mut out[..wide_nodes_needed(2 * W, W)];
         assert_eq!(out.len(), W + 1);
-        let greedy = layout(src, &mut out, |s| greedy_roots(src, s)).unwrap();
+        let greedy = layout(src, out, |s| greedy_roots(src, s)).unwrap();
         assert_eq!(greedy, (W + 1, 1));
         assert!(out.iter().skip(1).all(|n| n.child_count() == 2));
-        let optimal = layout(src, &mut out, |s| costs.roots(src, s)).unwrap();
+        let optimal = layout(src, out, |s| costs.roots(src, s)).unwrap();
         assert!(optimal.0 < W + 1, "{W}-wide: {optimal:?}");
     }
 
@@ -498,13 +495,14 @@ mod tests {
 
     #[test]
     fn scratch_shorter_than_the_table_is_a_typed_error() {
-        with_table::<8>(40, 0, |src, _| {
+        with_table::<8>(40, 0, 1, |src, _| {
             let needed = 7 * src.len();
-            let mut out = std::vec![WideNode::<f32, 8>::EMPTY; wide_nodes_needed(40, 8)];
-            let mut scratch = std::vec![0u32; needed];
-            assert!(collapse(src, &mut out, &mut scratch, 40).is_ok());
+            let mut out = [WideNode::<f32, 8>::EMPTY; MAX];
+            let out = &mut out[..wide_nodes_needed(40, 8)];
+            let mut scratch = [0u32; 7 * NODES];
+            assert!(collapse(src, out, &mut scratch[..needed], 40).is_ok());
             assert_eq!(
-                collapse(src, &mut out, &mut scratch[..needed - 1], 40),
+                collapse(src, out, &mut scratch[..needed - 1], 40),
                 Err(BuildError::ArenaTooSmall {
                     arena: Arena::Scratch,
                     needed,
