@@ -64,12 +64,12 @@ pub(super) fn collapse<S: Scalar, const W: usize>(
         *first = n;
         return Ok((1, 0));
     }
-    lay_out(src, out, &Costs::<W>::plan(src, scratch)).ok_or(too_small)
+    optimal_or_greedy(src, out, &Costs::<W>::plan(src, scratch)).ok_or(too_small)
 }
 
 /// The tree `costs` describe if it fits `out`, otherwise the greedy one (`None` if neither
 /// does, which a BVH2 from [`crate::Bvh::build`] and an arena of the bound never meet).
-fn lay_out<S: Scalar, const W: usize>(
+fn optimal_or_greedy<S: Scalar, const W: usize>(
     src: &[Node<S>],
     out: &mut [WideNode<S, W>],
     costs: &Costs<W>,
@@ -449,10 +449,10 @@ mod tests {
             let (greedy, _) = layout(src, &mut out, |s| greedy_roots(src, s)).unwrap();
             let greedy_tree = out;
             assert_eq!((optimal, greedy), (8, 7));
-            let fits = lay_out(src, &mut out[..optimal], costs).unwrap();
+            let fits = optimal_or_greedy(src, &mut out[..optimal], costs).unwrap();
             assert_eq!(fits.0, optimal);
             assert_ne!(out[..optimal], greedy_tree[..optimal]);
-            let falls_back = lay_out(src, &mut out[..optimal - 1], costs).unwrap();
+            let falls_back = optimal_or_greedy(src, &mut out[..optimal - 1], costs).unwrap();
             assert_eq!(falls_back.0, greedy);
             assert_eq!(out[..greedy], greedy_tree[..greedy]);
         });
