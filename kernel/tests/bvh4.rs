@@ -149,18 +149,23 @@ const T: f32 = f32::from_bits(1);
 /// decides by the operand order of `min` and `max`.
 const TINY_COORDS: [f32; 5] = [-T, -0.0, 0.0, T, 2.0 * T];
 
-/// Eight boxes for [`axis_cases`] with [`TINY_COORDS`]: planes on, just inside and just outside
-/// the shifted origins.
-const TINY_BOXES8: [([f32; 3], [f32; 3]); 8] = [
-    ([T, T, T], [1.0, 1.0, 1.0]),
-    ([-1.0, -1.0, -1.0], [-T, -T, -T]),
-    ([2.0 * T, 2.0 * T, 2.0 * T], [1.0, 1.0, 1.0]),
-    ([-1.0, -1.0, -1.0], [-2.0 * T, -2.0 * T, -2.0 * T]),
-    ([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]),
-    ([-T, -T, -T], [T, T, T]),
-    ([T, -1.0, -1.0], [1.0, 1.0, 1.0]),
-    ([-1.0, T, -1.0], [1.0, 1.0, -T]),
-];
+/// Eight boxes with planes on, just inside and just outside origins a few steps `u` from
+/// zero (for [`axis_cases`]).
+const fn boxes_around_origins(u: f32) -> [([f32; 3], [f32; 3]); 8] {
+    [
+        ([u, u, u], [1.0, 1.0, 1.0]),
+        ([-1.0, -1.0, -1.0], [-u, -u, -u]),
+        ([2.0 * u, 2.0 * u, 2.0 * u], [1.0, 1.0, 1.0]),
+        ([-1.0, -1.0, -1.0], [-2.0 * u, -2.0 * u, -2.0 * u]),
+        ([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]),
+        ([-u, -u, -u], [u, u, u]),
+        ([u, -1.0, -1.0], [1.0, 1.0, 1.0]),
+        ([-1.0, u, -1.0], [1.0, 1.0, -u]),
+    ]
+}
+
+/// Boxes around [`TINY_COORDS`].
+const TINY_BOXES8: [([f32; 3], [f32; 3]); 8] = boxes_around_origins(T);
 
 /// One raw unit of fixed point (2^-16): how far its slab test shifts an origin.
 const R: f32 = 1.0 / 65_536.0;
@@ -170,16 +175,7 @@ const R: f32 = 1.0 / 65_536.0;
 const RAW_COORDS: [f32; 5] = [-R, 0.0, R, 2.0 * R, 3.0 * R];
 
 /// [`TINY_BOXES8`] in raw units of fixed point.
-const RAW_BOXES8: [([f32; 3], [f32; 3]); 8] = [
-    ([R, R, R], [1.0, 1.0, 1.0]),
-    ([-1.0, -1.0, -1.0], [-R, -R, -R]),
-    ([2.0 * R, 2.0 * R, 2.0 * R], [1.0, 1.0, 1.0]),
-    ([-1.0, -1.0, -1.0], [-2.0 * R, -2.0 * R, -2.0 * R]),
-    ([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]),
-    ([-R, -R, -R], [R, R, R]),
-    ([R, -1.0, -1.0], [1.0, 1.0, 1.0]),
-    ([-1.0, R, -1.0], [1.0, 1.0, -R]),
-];
+const RAW_BOXES8: [([f32; 3], [f32; 3]); 8] = boxes_around_origins(R);
 
 /// The first four [`TINY_BOXES8`].
 const TINY_BOXES4: [([f32; 3], [f32; 3]); 4] = [
