@@ -4,7 +4,8 @@
 //!   planes, flat boxes, intervals);
 //! - `Numerics::slab8` gives each of its eight boxes exactly the decision and entry bits
 //!   `slab4` gives it in its half, in both modes (so `slab`'s in `f32`), on the same kinds of
-//!   cases; where the CPU has AVX2, `Numerics::slab8_avx2` (256-bit lanes) gives `slab8`'s;
+//!   cases; where the CPU has AVX2, `Numerics::slab8_avx2` (256-bit lanes) gives `slab8`'s,
+//!   also for intervals that end just short of a box's entry (where the exit's slack decides);
 //! - why unused slots are masked by their count rather than by an "empty" box: the slab test
 //!   accepts an inverted box for some ray;
 //! - the collapse, for both widths: arena sizes (`wide_nodes_needed` bounds every collapse and
@@ -371,12 +372,50 @@ fn slab8_avx2_equals_slab8<S: TestScalar>(cases: impl IntoIterator<Item = (RaySp
     outcomes.assert_both_above(1000);
 }
 
-/// Where the CPU has AVX2: [`slab8_avx2_equals_slab8`] on random and axis cases, both modes.
+/// [`random_cases`] again, each followed by copies whose interval ends just short of the entry
+/// `slab8` gives one of the boxes it accepts: by 1 to 4 units of the last place of that entry
+/// (one raw unit in fixed point) and by 2^-21 to 2^-18 of it relatively, so that the slack a
+/// box test grants at the end of the interval (a widened or grown exit, fixed point's
+/// `t_max + 2`) decides boxes there.
+fn near_entry_cases<S: TestScalar>(
+    seed: u64,
+    count: usize,
+) -> impl Iterator<Item = (RaySpec, Boxes<S, 8>)> {
+    random_cases::<S, 8>(seed, count).flat_map(|(spec, (lo, hi))| {
+        let ray = spec.ray::<S>();
+        let (mask, t) = S::slab8(ray.data(), &lo, &hi, ray.t_min(), ray.t_max());
+        let mut cases = vec![(spec, (lo, hi))];
+        for (b, entry) in t.iter().enumerate() {
+            let entry = entry.to_f32();
+            if mask >> b & 1 == 0 || entry <= spec.t_min || !entry.is_finite() {
+                continue;
+            }
+            // One unit of the last place of the entry as the mode stores it.
+            let unit = if S::NAME == "fixed" {
+                1.0 / 65536.0
+            } else {
+                f32::from_bits(entry.to_bits() + 1) - entry
+            };
+            let short = (1..=4)
+                .map(|k| entry - k as f32 * unit)
+                .chain((18..=21).map(|e| entry * (1.0 - 0.5f32.powi(e))));
+            for t_max in short.filter(|&t| t >= spec.t_min) {
+                cases.push((spec.interval(spec.t_min, t_max), (lo, hi)));
+            }
+        }
+        cases
+    })
+}
+
+/// Where the CPU has AVX2: [`slab8_avx2_equals_slab8`] on random, near-entry and axis cases,
+/// both modes.
 #[test]
 fn slab8_avx2_equals_slab8_where_the_cpu_has_avx2() {
     #[cfg(target_arch = "x86_64")]
     if std::is_x86_feature_detected!("avx2") {
         slab8_avx2_equals_slab8::<f32>(random_cases(0xa7c8, 20_000));
+        slab8_avx2_equals_slab8::<f32>(near_entry_cases(0xe7e8, 3_000));
+        slab8_avx2_equals_slab8::<I16F16>(near_entry_cases(0xe7e8, 3_000));
         slab8_avx2_equals_slab8::<f32>(axis_cases(AXIS_BOXES8, AXIS_COORDS));
         slab8_avx2_equals_slab8::<f32>(axis_cases(TINY_BOXES8, TINY_COORDS));
         slab8_avx2_equals_slab8::<I16F16>(random_cases(0xa7c8, 20_000));
