@@ -20,10 +20,8 @@
 //! - [`cli`]: the command line (clap) and the commands behind it,
 //! - [`console`]: lines for people (summaries, warnings, progress) apart from the report,
 //! - [`output`]: output files checked and reserved before the work,
-//! - [`error`]: the error type `main` turns into a message and an exit code,
-//! - [`pages`]: buffers for the kernel's memory, on huge pages where the OS offers them (the
-//!   one module with `unsafe`: a single `madvise` call).
-#![deny(unsafe_code)]
+//! - [`error`]: the error type `main` turns into a message and an exit code.
+#![forbid(unsafe_code)]
 
 pub mod bake;
 pub mod check;
@@ -39,7 +37,6 @@ pub mod limits;
 pub mod mtl;
 pub mod obj;
 pub mod output;
-pub mod pages;
 pub mod rayfile;
 pub mod render;
 pub mod scene;

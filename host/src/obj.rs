@@ -76,21 +76,22 @@ impl Mesh {
     /// [`ObjErrorKind::UnusableVertex`] at the line of the first vertex that mode `S` cannot
     /// represent (fixed point rejects coordinates beyond ±8192).
     pub fn kernel_triangles<S: Scalar>(&self, path: &Path) -> Result<Vec<Triangle<S>>, ObjError> {
-        let triangles = (0..self.triangles.len()).map(|id| {
-            Triangle::from_f32(self.triangle_f32(id)).map_err(|e| {
-                let vertex = self.triangles[id][e.vertex] as usize;
-                ObjError::at(
-                    path,
-                    self.position_lines[vertex],
-                    ObjErrorKind::UnusableVertex {
-                        triangle: id,
-                        mode: S::NAME,
-                        error: e.error,
-                    },
-                )
+        (0..self.triangles.len())
+            .map(|id| {
+                Triangle::from_f32(self.triangle_f32(id)).map_err(|e| {
+                    let vertex = self.triangles[id][e.vertex] as usize;
+                    ObjError::at(
+                        path,
+                        self.position_lines[vertex],
+                        ObjErrorKind::UnusableVertex {
+                            triangle: id,
+                            mode: S::NAME,
+                            error: e.error,
+                        },
+                    )
+                })
             })
-        });
-        crate::pages::collected(self.triangles.len(), triangles)
+            .collect()
     }
 }
 
