@@ -385,17 +385,12 @@ fn near_entry_cases<S: TestScalar>(
         let ray = spec.ray::<S>();
         let (mask, t) = S::slab8(ray.data(), &lo, &hi, ray.t_min(), ray.t_max());
         let mut cases = vec![(spec, (lo, hi))];
-        for (b, entry) in t.iter().enumerate() {
-            let entry = entry.to_f32();
+        for (b, &stored) in t.iter().enumerate() {
+            let entry = stored.to_f32();
             if mask >> b & 1 == 0 || entry <= spec.t_min || !entry.is_finite() {
                 continue;
             }
-            // One unit of the last place of the entry as the mode stores it.
-            let unit = if S::NAME == "fixed" {
-                1.0 / 65536.0
-            } else {
-                f32::from_bits(entry.to_bits() + 1) - entry
-            };
+            let unit = stored.step_above();
             let short = (1..=4)
                 .map(|k| entry - k as f32 * unit)
                 .chain((18..=21).map(|e| entry * (1.0 - 0.5f32.powi(e))));

@@ -29,6 +29,8 @@ pub trait TestScalar:
     fn bad_coords() -> Vec<(Self, PointError)>;
     /// Half of `self`, rounded as the mode rounds.
     fn half(self) -> Self;
+    /// The gap from `self` (positive, finite) to the next value of the mode above it.
+    fn step_above(self) -> f32;
 }
 
 impl TestScalar for f32 {
@@ -52,6 +54,9 @@ impl TestScalar for f32 {
     fn half(self) -> Self {
         self * 0.5
     }
+    fn step_above(self) -> f32 {
+        next_up(self) - self
+    }
 }
 
 impl TestScalar for I16F16 {
@@ -74,6 +79,9 @@ impl TestScalar for I16F16 {
     fn half(self) -> Self {
         // Floor; exact for even raw values.
         I16F16::from_raw(self.raw() >> 1)
+    }
+    fn step_above(self) -> f32 {
+        1.0 / 65536.0 // one raw unit
     }
 }
 
