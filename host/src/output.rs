@@ -142,8 +142,11 @@ impl Drop for Reserved {
 mod tests {
     use super::*;
 
+    /// An empty directory for one test: emptied first, since a process id (its name) can come
+    /// back in a later run, whose leftover files would change what the test sees.
     fn dir(name: &str) -> PathBuf {
         let d = std::env::temp_dir().join(format!("raykernel-out-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
         std::fs::create_dir_all(&d).unwrap();
         d
     }
@@ -156,6 +159,7 @@ mod tests {
         assert!(e.to_string().contains("`.jpg`, but it writes a PNG"), "{e}");
         assert!(!d.join("pic.jpg").exists());
         assert!(Reserved::new(&d.join("PIC.PNG"), Format::Png, "--out").is_ok());
+        std::fs::remove_dir_all(&d).unwrap();
     }
 
     #[test]
@@ -174,5 +178,6 @@ mod tests {
             .write(b"new")
             .unwrap();
         assert_eq!(std::fs::read(&p).unwrap(), b"new");
+        std::fs::remove_dir_all(&d).unwrap();
     }
 }
