@@ -142,6 +142,9 @@ fn check_coord(x: f32) -> Result<(), PointError> {
     }
 }
 
+/// The float just below 1, `1 - 2^-24`: its correctly rounded square root is itself.
+const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
+
 /// Unit vector along `d` in `f32`, z repeated in lane 3: [`normalized`]`(d)`, bit for bit, but
 /// found without a square root or a division when `d` is already a unit vector as [`normalized`]
 /// sees it (most unit vectors a caller rounds to `f32`).
@@ -152,14 +155,20 @@ fn check_coord(x: f32) -> Result<(), PointError> {
 /// with rounding; a square small enough to round differently once scaled lies far below half
 /// an ulp of a sum near 1 and vanishes in it either way), so the length is `k·sqrtf(q) = k`
 /// (the square root of `1 + 2^-23` lies just under the midpoint `1 + 2^-24` and rounds to 1),
-/// and each quotient `(k·d_i) / k` is `d_i`. Non-finite components make `q` non-finite and go
-/// to [`normalized`], which rejects them.
+/// and each quotient `(k·d_i) / k` is `d_i`. When `q` is the float below 1, `1 - 2^-24` (as
+/// common among rounded unit vectors), the length is likewise `k·sqrtf(q) = k·q` (the square
+/// root lies just under the midpoint `1 - 2^-25` and rounds to `q`), so the quotients are
+/// `d_i / q`: one division, without the scaling and the square root. Non-finite components
+/// make `q` non-finite and go to [`normalized`], which rejects them.
 #[cfg_attr(not(target_os = "none"), inline(always))]
 fn unit_dir(d: [f32; 3]) -> Result<[f32; 4], RayError> {
     let q = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
     // `q` is 1 (bits 0x3f80_0000) or the next float up: one unsigned comparison.
     if q.to_bits().wrapping_sub(1.0f32.to_bits()) <= 1 {
         return Ok(lanes(d));
+    }
+    if q == BELOW_ONE {
+        return Ok(vector(&d).div(F4::splat(BELOW_ONE)).to_array());
     }
     normalized(d)
 }
@@ -903,14 +912,15 @@ mod tests {
 
     use crate::scalar::xorshift as next;
 
-    /// `unit_dir` takes `d` as given exactly when `normalized` returns it bit for bit: checked on
-    /// unit vectors rounded from `f64` (with tiny and zero components, of every sign and order),
-    /// which take the shortcut most of the time, and on their neighbours one ulp away.
+    /// `unit_dir` takes `d` as given exactly when `normalized` returns it bit for bit, and its
+    /// quotient by `1 - 2^-24` is `normalized`'s: checked on unit vectors rounded from `f64`
+    /// (with tiny and zero components, of every sign and order), which take a shortcut most of
+    /// the time, and on their neighbours one ulp away.
     #[test]
     fn unit_dir_shortcut_is_the_normalisation() {
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
         let mut unit = || (next(&mut state) >> 11) as f64 / 9_007_199_254_740_992.0 * 2.0 - 1.0;
-        let (mut shortcut, mut total) = (0usize, 0usize);
+        let (mut shortcut, mut below, mut total) = (0usize, 0usize, 0usize);
         for i in 0..400_000 {
             let mut v = [unit(), unit(), unit()];
             match i % 8 {
@@ -935,12 +945,14 @@ mod tests {
                 total += 1;
                 let q = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
                 shortcut += usize::from(q == 1.0 || q == 1.0 + f32::EPSILON);
+                below += usize::from(q == BELOW_ONE);
             }
         }
         assert!(
             shortcut > total / 3,
             "shortcut taken {shortcut} of {total} times"
         );
+        assert!(below > total / 20, "q = 1 - 2^-24 {below} of {total} times");
         for bad in [[f32::NAN, 0.0, 1.0], [f32::INFINITY, 0.0, 0.0], [0.0; 3]] {
             assert!(unit_dir(bad).is_err(), "{bad:?}");
         }
