@@ -9,10 +9,7 @@ use std::process::Command;
 
 /// A fresh, empty directory under the integration tests' temp dir.
 fn temp_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    raykernel_testkit::empty_dir(Path::new(env!("CARGO_TARGET_TMPDIR")).join(name))
 }
 
 /// An icosphere of `20·4^levels` triangles around `center` as OBJ text.

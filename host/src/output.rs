@@ -142,13 +142,12 @@ impl Drop for Reserved {
 mod tests {
     use super::*;
 
-    /// An empty directory for one test: emptied first, since a process id (its name) can come
-    /// back in a later run, whose leftover files would change what the test sees.
+    /// An empty directory for one test.
     fn dir(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("raykernel-out-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        d
+        let pid = std::process::id();
+        raykernel_testkit::empty_dir(
+            std::env::temp_dir().join(format!("raykernel-out-{name}-{pid}")),
+        )
     }
 
     #[test]

@@ -18,12 +18,11 @@ fn repo(rel: &str) -> PathBuf {
 }
 
 fn temp_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("formats")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    raykernel_testkit::empty_dir(
+        Path::new(env!("CARGO_TARGET_TMPDIR"))
+            .join("formats")
+            .join(name),
+    )
 }
 
 /// Runs `render` with these arguments (after the subcommand).

@@ -18,3 +18,16 @@ pub mod rng;
 pub mod vec3;
 
 pub use rng::Rng;
+
+/// `dir`, created empty: whatever an earlier run left there (a test directory named by a
+/// process id can come back in a later run) is removed first.
+///
+/// # Panics
+/// If the directory cannot be created.
+#[cfg(feature = "std")]
+#[must_use]
+pub fn empty_dir(dir: std::path::PathBuf) -> std::path::PathBuf {
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}

@@ -9,10 +9,7 @@ pub use raykernel_testkit::Rng;
 
 /// A fresh, empty directory under the integration tests' temp dir.
 pub fn temp_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    raykernel_testkit::empty_dir(Path::new(env!("CARGO_TARGET_TMPDIR")).join(name))
 }
 
 /// A closed triangle mesh: an icosahedron subdivided `levels` times, projected on a sphere.

@@ -155,7 +155,7 @@ const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
 /// with rounding; a square small enough to round differently once scaled lies far below half
 /// an ulp of a sum near 1 and vanishes in it either way), so the length is `k·sqrtf(q) = k`
 /// (the square root of `1 + 2^-23` lies just under the midpoint `1 + 2^-24` and rounds to 1),
-/// and each quotient `(k·d_i) / k` is `d_i`. When `q` is the float below 1, `1 - 2^-24` (as
+/// and each quotient `(k·d_i) / k` is `d_i`. When `q` is the float below 1, `1 - 2^-24` (also
 /// common among rounded unit vectors), the length is likewise `k·sqrtf(q) = k·q` (the square
 /// root lies just under the midpoint `1 - 2^-25` and rounds to `q`), so the quotients are
 /// `d_i / q`: one division, without the scaling and the square root. Non-finite components

@@ -81,7 +81,7 @@ impl TestScalar for I16F16 {
         I16F16::from_raw(self.raw() >> 1)
     }
     fn step_above(self) -> f32 {
-        1.0 / 65536.0 // one raw unit
+        I16F16::from_raw(1).to_f32()
     }
 }
 
