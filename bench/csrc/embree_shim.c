@@ -86,15 +86,14 @@ RTCScene rkb_embree_build(rkb_embree *e, const float *vertices, size_t vertex_co
 
 void rkb_embree_scene_free(RTCScene scene) { rtcReleaseScene(scene); }
 
-/* Closest hit of every `stride`-th of `count` records (8 floats each: origin, direction,
- * tmin, tmax): t and primitive id per traced record (+inf and 0xFFFFFFFF on a miss). */
-void rkb_embree_closest(RTCScene scene, const float *records, size_t count, size_t stride,
-                        float *t_out, uint32_t *prim_out) {
+/* Closest hit of each of `count` records (8 floats each: origin, direction, tmin, tmax):
+ * t and primitive id per record (+inf and 0xFFFFFFFF on a miss). */
+void rkb_embree_closest(RTCScene scene, const float *records, size_t count, float *t_out,
+                        uint32_t *prim_out) {
     struct RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    size_t k = 0;
-    for (size_t i = 0; i < count; i += stride, k++) {
-        const float *r = records + 8 * i;
+    for (size_t k = 0; k < count; k++) {
+        const float *r = records + 8 * k;
         struct RTCRayHit rh;
         rh.ray.org_x = r[0];
         rh.ray.org_y = r[1];
@@ -122,12 +121,12 @@ void rkb_embree_closest(RTCScene scene, const float *records, size_t count, size
     }
 }
 
-/* Any hit of every `stride`-th record: how many are occluded. */
-size_t rkb_embree_occluded(RTCScene scene, const float *records, size_t count, size_t stride) {
+/* Any hit of each of `count` records: how many are occluded. */
+size_t rkb_embree_occluded(RTCScene scene, const float *records, size_t count) {
     struct RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     size_t occluded = 0;
-    for (size_t i = 0; i < count; i += stride) {
+    for (size_t i = 0; i < count; i++) {
         const float *r = records + 8 * i;
         struct RTCRay ray;
         ray.org_x = r[0];

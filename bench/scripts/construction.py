@@ -41,35 +41,38 @@ def cpu_name():
     return platform.processor() or "unknown CPU"
 
 
-# The harness that times construction, spliced from the current host into the before build:
-# `prepare_rays` and the helpers it calls (inserted before it where the before build lacks them).
-HARNESS = ["prepare_rays", "placeholder"]
+# The harness that times construction, spliced from the current host into the before build's
+# trace.rs: `prepare_rays` and the helpers it calls (inserted before it where the before build
+# lacks them), each with the host file it comes from.
+HARNESS = [("prepare_rays", "trace.rs"), ("placeholder", "trace.rs"), ("every", "rayfile.rs")]
 
 
 def function_span(text, name):
-    """The function `name` in `text` (the host's trace.rs) as (start, end) offsets, or None."""
+    """The function `name` in `text` (a host source file) as (start, end) offsets, or None."""
     for prefix in ("pub fn ", "fn "):
-        start = text.find(f"\n{prefix}{name}<")
-        if start >= 0:
-            end = text.find("\n}\n", start)
-            return start + 1, end + 3
+        for after in ("<", "("):
+            start = text.find(f"\n{prefix}{name}{after}")
+            if start >= 0:
+                end = text.find("\n}\n", start)
+                return start + 1, end + 3
     return None
 
 
 def splice_harness(current, old, path):
-    """`old` with the current harness functions in place of its own."""
-    for name in HARNESS:
-        span = function_span(current, name)
+    """`old` with the current harness functions in place of its own; `current` maps each host
+    file name to its current text."""
+    for name, source in HARNESS:
+        span = function_span(current[source], name)
         if span is None:
-            sys.exit(f"no {name} in the current host's trace.rs")
-        body = current[span[0]:span[1]]
+            sys.exit(f"no {name} in the current host's {source}")
+        body = current[source][span[0]:span[1]]
         mine = function_span(old, name)
         if mine is not None:
             old = old[:mine[0]] + body + old[mine[1]:]
         else:
-            at = function_span(old, HARNESS[0])
+            at = function_span(old, HARNESS[0][0])
             if at is None:
-                sys.exit(f"no {HARNESS[0]} in {path}")
+                sys.exit(f"no {HARNESS[0][0]} in {path}")
             old = old[:at[0]] + body + "\n" + old[at[0]:]
     return old
 
@@ -83,10 +86,11 @@ def build_before(rev, repo):
     target = os.path.join(work, "target")
     subprocess.run(["git", "-C", repo, "worktree", "add", "-q", "--detach", tree, rev], check=True)
     try:
-        current_path = os.path.join(repo, "host/src/trace.rs")
+        current = {}
+        for _, source in HARNESS:
+            with open(os.path.join(repo, "host/src", source)) as f:
+                current[source] = f.read()
         old_path = os.path.join(tree, "host/src/trace.rs")
-        with open(current_path) as f:
-            current = f.read()
         with open(old_path) as f:
             old = f.read()
         with open(old_path, "w") as f:

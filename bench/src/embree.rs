@@ -53,16 +53,10 @@ mod ffi {
             scene: *mut c_void,
             records: *const f32,
             count: usize,
-            stride: usize,
             t_out: *mut f32,
             prim_out: *mut u32,
         );
-        pub fn rkb_embree_occluded(
-            scene: *mut c_void,
-            records: *const f32,
-            count: usize,
-            stride: usize,
-        ) -> usize;
+        pub fn rkb_embree_occluded(scene: *mut c_void, records: *const f32, count: usize) -> usize;
     }
 }
 
@@ -204,24 +198,21 @@ impl<'d> Scene<'d> {
         ))
     }
 
-    /// Closest hit of every `stride`-th record (one `rtcIntersect1` each, timed) and the
-    /// loop's wall time, ms. `records` is [`flat_records`] of the ray set.
+    /// Closest hit of every record (one `rtcIntersect1` each, timed) and the loop's wall
+    /// time, ms. `records` is [`flat_records`] of the ray set.
     #[must_use]
-    pub fn closest(&self, records: &[f32], stride: usize) -> (Vec<HitRecord>, f64) {
-        let stride = stride.max(1);
+    pub fn closest(&self, records: &[f32]) -> (Vec<HitRecord>, f64) {
         let count = records.len() / 8;
-        let n = count.div_ceil(stride);
-        let mut t = vec![f32::INFINITY; n];
-        let mut prim = vec![u32::MAX; n];
+        let mut t = vec![f32::INFINITY; count];
+        let mut prim = vec![u32::MAX; count];
         let start = Instant::now();
         // SAFETY: the scene is live; `records` holds `count` 8-float records; the outputs
-        // hold one slot per traced record (`ceil(count / stride)`).
+        // hold one slot per record.
         unsafe {
             ffi::rkb_embree_closest(
                 self.raw.as_ptr(),
                 records.as_ptr(),
                 count,
-                stride,
                 t.as_mut_ptr(),
                 prim.as_mut_ptr(),
             );
@@ -242,20 +233,14 @@ impl<'d> Scene<'d> {
         (hits, ms)
     }
 
-    /// Any hit of every `stride`-th record (one `rtcOccluded1` each, timed): how many are
-    /// occluded, and the loop's wall time, ms.
+    /// Any hit of every record (one `rtcOccluded1` each, timed): how many are occluded, and
+    /// the loop's wall time, ms.
     #[must_use]
-    pub fn occluded(&self, records: &[f32], stride: usize) -> (usize, f64) {
-        let stride = stride.max(1);
+    pub fn occluded(&self, records: &[f32]) -> (usize, f64) {
         let start = Instant::now();
         // SAFETY: as in `closest`.
         let n = unsafe {
-            ffi::rkb_embree_occluded(
-                self.raw.as_ptr(),
-                records.as_ptr(),
-                records.len() / 8,
-                stride,
-            )
+            ffi::rkb_embree_occluded(self.raw.as_ptr(), records.as_ptr(), records.len() / 8)
         };
         let ms = millis(start);
         clear_upper_vector_state();
@@ -270,12 +255,14 @@ impl Drop for Scene<'_> {
     }
 }
 
-/// The records as Embree's shim reads them: 8 floats each (origin, direction, tmin, tmax),
-/// the ray file's layout.
+/// Every `stride`-th record as Embree's shim reads them: 8 floats each (origin, direction,
+/// tmin, tmax, the ray file's layout), next to each other as the kernel's timed loops read
+/// theirs ([`host::rayfile::every`]).
 #[must_use]
-pub fn flat_records(records: &[RayRecord]) -> Vec<f32> {
+pub fn flat_records(records: &[RayRecord], stride: usize) -> Vec<f32> {
     records
         .iter()
+        .step_by(stride.max(1))
         .flat_map(|r| {
             [
                 r.origin[0],

@@ -16,7 +16,7 @@ use crate::ours::{mrays, RunOptions};
 use crate::results::TraceRow;
 use crate::workload::{BenchScene, RaySet};
 use glam_peer::Vec3A;
-use host::rayfile::HitRecord;
+use host::rayfile::{HitRecord, RayRecord};
 use host::trace::{median, millis};
 use std::cell::Cell;
 use std::hint::black_box;
@@ -114,7 +114,9 @@ pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Op
     let tris: Vec<[[f32; 3]; 3]> = (0..scene.mesh.triangle_count())
         .map(|i| scene.mesh.triangle_f32(i))
         .collect();
-    let records: Vec<_> = set.records.iter().step_by(opts.stride.max(1)).collect();
+    // Converted from the traced records gathered densely, as every timed loop reads them.
+    let dense = host::rayfile::every(&set.records, opts.stride);
+    let records: Vec<&RayRecord> = dense.iter().collect();
     let runs = opts.runs.max(1);
     let m = match peer {
         Peer::ObvhsBvh2 | Peer::ObvhsCwbvh => obvhs_run(peer, &tris, &records, runs),
@@ -207,18 +209,18 @@ mod embree_peer {
     ) -> Option<PeerMeasured> {
         let device = Device::new()?;
         let geometry = Geometry::of(mesh);
-        let flat = flat_records(records);
+        let flat = flat_records(records, opts.stride);
         let (mut builds, mut closest) = (Vec::new(), Vec::new());
         let mut m = empty_measured();
         for run in 0..opts.runs.max(1) {
             let (scene, built) = Scene::build(&device, &geometry, quality)?;
             builds.push(built.build_ms);
-            let (hits, ms) = scene.closest(&flat, opts.stride);
+            let (hits, ms) = scene.closest(&flat);
             closest.push(ms);
             m.hits = hits;
             m.bytes = built.bytes;
             if run + 1 == opts.runs.max(1) {
-                let (occluded, ms) = scene.occluded(&flat, opts.stride);
+                let (occluded, ms) = scene.occluded(&flat);
                 m.any_hits = occluded;
                 m.any_ms = ms;
             }

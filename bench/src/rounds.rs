@@ -265,7 +265,7 @@ impl Alternate<'_> {
     fn run<A: Accel<f32>, B: Accel<f32>>(self, first: &A, second: &B) -> Figures {
         let n = self.prepared.rays.len();
         let mut figures = Figures::default();
-        let inputs = EmbreeInputs::new(self.scene, self.records, self.with_peers);
+        let inputs = EmbreeInputs::new(self.scene, self.records, self.stride, self.with_peers);
         let embree = inputs.build();
         let round = |figures: &mut Figures| {
             let [per_ray_a, per_ray_b] = &mut figures.per_ray;
@@ -278,7 +278,7 @@ impl Alternate<'_> {
                 trace_closest_per_ray(second, self.records, self.stride).1,
             ));
             if let Some(e) = &embree {
-                figures.embree.push(e.trace(self.stride));
+                figures.embree.push(e.trace());
             }
             let [prebuilt_a, prebuilt_b] = &mut figures.prebuilt;
             prebuilt_a.push(mrays(n, trace_closest(first, self.prepared).1));
@@ -288,7 +288,8 @@ impl Alternate<'_> {
             let tris: Vec<[[f32; 3]; 3]> = (0..self.scene.mesh.triangle_count())
                 .map(|i| self.scene.mesh.triangle_f32(i))
                 .collect();
-            let records: Vec<&RayRecord> = self.records.iter().step_by(self.stride).collect();
+            let dense = host::rayfile::every(self.records, self.stride);
+            let records: Vec<&RayRecord> = dense.iter().collect();
             crate::peers::alternate_with_tinybvh(&tris, &records, self.rounds, &mut || {
                 round(&mut figures);
             })
@@ -318,13 +319,13 @@ struct EmbreeInputs {
 
 #[cfg(feature = "embree")]
 impl EmbreeInputs {
-    fn new(scene: &BenchScene, records: &[RayRecord], wanted: bool) -> Self {
+    fn new(scene: &BenchScene, records: &[RayRecord], stride: usize, wanted: bool) -> Self {
         use crate::embree::{flat_records, Device, Geometry};
         Self {
             device: if wanted { Device::new() } else { None },
             geometry: Geometry::of(&scene.mesh),
             flat: if wanted {
-                flat_records(records)
+                flat_records(records, stride)
             } else {
                 Vec::new()
             },
@@ -350,8 +351,8 @@ struct EmbreeTracer<'a> {
 
 #[cfg(feature = "embree")]
 impl EmbreeTracer<'_> {
-    fn trace(&self, stride: usize) -> f64 {
-        let (hits, ms) = self.scene.closest(self.flat, stride);
+    fn trace(&self) -> f64 {
+        let (hits, ms) = self.scene.closest(self.flat);
         mrays(hits.len(), ms)
     }
 }
@@ -361,7 +362,7 @@ struct EmbreeInputs;
 
 #[cfg(not(feature = "embree"))]
 impl EmbreeInputs {
-    fn new(_: &BenchScene, _: &[RayRecord], _: bool) -> Self {
+    fn new(_: &BenchScene, _: &[RayRecord], _: usize, _: bool) -> Self {
         Self
     }
 
@@ -375,7 +376,7 @@ struct EmbreeTracer;
 
 #[cfg(not(feature = "embree"))]
 impl EmbreeTracer {
-    fn trace(&self, _: usize) -> f64 {
+    fn trace(&self) -> f64 {
         0.0
     }
 }

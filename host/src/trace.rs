@@ -14,7 +14,7 @@
 
 use crate::error::Error;
 use crate::obj::Mesh;
-use crate::rayfile::{HitRecord, RayRecord};
+use crate::rayfile::{every, HitRecord, RayRecord};
 use raykernel::bvh::BuilderKind;
 use raykernel::{
     Accel, AccelKind, AccelMemory, AccelVisitor, AnyAccel, KdNode, Node, Node4, Node8, Primitive,
@@ -440,8 +440,9 @@ fn trace_rays<S: Scalar, A: Accel<S>>(
 
 /// Closest hit of every `stride`-th record: one kernel ray, set from each record's raw origin,
 /// direction and interval ([`Ray::set_from_f32`], in place) inside the timed loop, then
-/// traced: what a caller pays per query. A record the kernel rejects is a miss. Returns the
-/// hits and the loop's wall time, ms.
+/// traced: what a caller pays per query. The loop reads the traced records gathered densely
+/// ([`every`], untimed). A record the kernel rejects is a miss. Returns the hits and the
+/// loop's wall time, ms.
 ///
 /// # Panics
 /// If `stride` is 0.
@@ -452,10 +453,11 @@ pub fn trace_closest_per_ray<S: Scalar, A: Accel<S>>(
     stride: usize,
 ) -> (Vec<HitRecord>, f64) {
     assert!(stride > 0, "stride must be at least 1");
-    let mut hits = vec![HitRecord::MISS; rays.len().div_ceil(stride)];
+    let rays = every(rays, stride);
+    let mut hits = vec![HitRecord::MISS; rays.len()];
     let mut ray = placeholder::<S>();
     let start = Instant::now();
-    for (slot, r) in hits.iter_mut().zip(rays.iter().step_by(stride)) {
+    for (slot, r) in hits.iter_mut().zip(&rays) {
         if ray.set_from_f32(r.origin, r.dir, r.t_min, r.t_max).is_err() {
             continue;
         }
@@ -470,7 +472,7 @@ pub fn trace_closest_per_ray<S: Scalar, A: Accel<S>>(
 }
 
 /// Any hit (occlusion) of every `stride`-th record, the kernel ray set from each record inside
-/// the timed loop as in [`trace_closest_per_ray`]. Returns how many are occluded and the loop's
+/// the timed loop (over the traced records gathered densely) as in [`trace_closest_per_ray`]. Returns how many are occluded and the loop's
 /// wall time, ms.
 ///
 /// # Panics
@@ -482,10 +484,11 @@ pub fn occluded_per_ray<S: Scalar, A: Accel<S>>(
     stride: usize,
 ) -> (usize, f64) {
     assert!(stride > 0, "stride must be at least 1");
+    let rays = every(rays, stride);
     let mut ray = placeholder::<S>();
     let start = Instant::now();
     let mut occluded = 0usize;
-    for r in rays.iter().step_by(stride) {
+    for r in &rays {
         if ray.set_from_f32(r.origin, r.dir, r.t_min, r.t_max).is_ok() {
             occluded += usize::from(accel.occluded(&ray));
         }
@@ -514,7 +517,8 @@ pub struct PreparedRays<S: Scalar> {
     pub setup_ms: f64,
 }
 
-/// Turns every `stride`-th record into a kernel ray (timed).
+/// Turns every `stride`-th record into a kernel ray (timed, over the records gathered densely
+/// as in [`trace_closest_per_ray`]).
 ///
 /// # Panics
 /// If `stride` is 0.
@@ -527,14 +531,11 @@ pub fn prepare_rays<S: Scalar>(rays: &[RayRecord], stride: usize) -> PreparedRay
     // place: the fill takes the page faults of fresh memory (most of the time of storing
     // 100+ bytes per ray), which are not ray construction. (One exact-size allocation:
     // growing a 100+ MB vector by reallocation measurably slowed the trace that follows.)
-    let mut prepared = vec![placeholder::<S>(); rays.len().div_ceil(stride)];
+    let rays = every(rays, stride);
+    let mut prepared = vec![placeholder::<S>(); rays.len()];
     let mut bad = Vec::new();
     let start = Instant::now();
-    for (i, (slot, r)) in prepared
-        .iter_mut()
-        .zip(rays.iter().step_by(stride))
-        .enumerate()
-    {
+    for (i, (slot, r)) in prepared.iter_mut().zip(&rays).enumerate() {
         match Ray::<S>::from_f32(r.origin, r.dir, r.t_min, r.t_max) {
             Ok(ray) => *slot = ray,
             Err(_) => bad.push(i),

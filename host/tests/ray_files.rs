@@ -4,8 +4,8 @@ mod common;
 
 use common::{temp_dir, Rng};
 use host::rayfile::{
-    encode_hits, encode_rays, parse_hits, parse_rays, read_hits, read_rays, write_hits, write_rays,
-    FileError,
+    encode_hits, encode_rays, every, parse_hits, parse_rays, read_hits, read_rays, write_hits,
+    write_rays, FileError,
 };
 use host::{HitRecord, RayRecord};
 use std::path::Path;
@@ -138,4 +138,18 @@ fn missing_and_unwritable_files_name_the_path() {
     let e = write_hits(&dir.join("no/such/dir.hits"), &[]).unwrap_err();
     assert!(matches!(e, FileError::Write { .. }), "{e:?}");
     assert!(e.to_string().contains("dir.hits: cannot write"), "{e}");
+}
+
+#[test]
+fn every_gathers_the_records_a_stride_traces_in_order() {
+    let rays = some_rays();
+    let picked: Vec<[u32; 8]> = every(&rays, 7).iter().map(bits).collect();
+    let expected: Vec<[u32; 8]> = (0..rays.len()).step_by(7).map(|i| bits(&rays[i])).collect();
+    assert_eq!(picked.len(), rays.len().div_ceil(7));
+    assert_eq!(picked, expected);
+    // Stride 1 keeps every record, and stride 0 counts as 1.
+    for stride in [0, 1] {
+        let all: Vec<[u32; 8]> = every(&rays, stride).iter().map(bits).collect();
+        assert_eq!(all, rays.iter().map(bits).collect::<Vec<_>>());
+    }
 }
