@@ -260,9 +260,8 @@ impl Drop for Scene<'_> {
 /// theirs ([`host::rayfile::every`]).
 #[must_use]
 pub fn flat_records(records: &[RayRecord], stride: usize) -> Vec<f32> {
-    records
+    host::rayfile::every(records, stride)
         .iter()
-        .step_by(stride.max(1))
         .flat_map(|r| {
             [
                 r.origin[0],
