@@ -15,9 +15,8 @@ use clap::Parser;
 use host::trace::{median, prepare_rays};
 use raykernel::cpu::{set_traversal_simd, Simd};
 use raykernel_bench::error::Error;
-use raykernel_bench::ours::RunOptions;
 use raykernel_bench::rounds;
-use raykernel_bench::workload::{load_scenes, BenchScene, RaySet, RaySource};
+use raykernel_bench::workload::{keep_every, load_scenes, BenchScene, RaySet, RaySource};
 use std::path::PathBuf;
 
 /// Interleaved rounds of the headline structure against Embree, without the rest of the
@@ -48,7 +47,7 @@ struct Args {
 /// Per round, the headline structures traced with the baseline copy of the traversal and then
 /// with the AVX2 copy; prints the per-round ratios (per ray, and their median on pre-built
 /// rays) of each. Leaves the copy the CPU supports selected.
-fn simd_ab(scene: &BenchScene, set: &RaySet, opts: RunOptions, rounds: usize) -> Result<(), Error> {
+fn simd_ab(scene: &BenchScene, set: &RaySet, rounds: usize) -> Result<(), Error> {
     let available = set_traversal_simd(Simd::Avx2);
     if available != Simd::Avx2 {
         println!(
@@ -63,7 +62,7 @@ fn simd_ab(scene: &BenchScene, set: &RaySet, opts: RunOptions, rounds: usize) ->
     for _ in 0..rounds.max(1) {
         let once = |simd| {
             set_traversal_simd(simd);
-            rounds::run(scene, set, opts, 1, false)
+            rounds::run(scene, set, 1, false)
         };
         let (base, avx2) = (once(Simd::Baseline)?, once(Simd::Avx2)?);
         let ratio = |a: &[f64], b: &[f64]| a.first().zip(b.first()).map_or(0.0, |(a, b)| a / b);
@@ -88,11 +87,11 @@ fn simd_ab(scene: &BenchScene, set: &RaySet, opts: RunOptions, rounds: usize) ->
 }
 
 /// Median ns per ray of the report's ray setup ([`prepare_rays`]: `Ray::from_f32` on every
-/// `stride`-th record, into a vector) over `rounds` timings.
-fn construction_ns(set: &RaySet, stride: usize, rounds: usize) -> f64 {
+/// traced record, into a vector) over `rounds` timings.
+fn construction_ns(set: &RaySet, rounds: usize) -> f64 {
     let timings: Vec<f64> = (0..rounds.max(1))
         .map(|_| {
-            let prepared = prepare_rays::<f32>(&set.records, stride);
+            let prepared = prepare_rays::<f32>(&set.records);
             prepared.setup_ms * 1e6 / prepared.rays.len().max(1) as f64
         })
         .collect();
@@ -101,13 +100,13 @@ fn construction_ns(set: &RaySet, stride: usize, rounds: usize) -> f64 {
 
 fn main() -> Result<(), Error> {
     let args = Args::parse();
-    let stride = args.stride.max(1);
     let source = RaySource::Files(args.rays.clone());
-    let scenes = load_scenes(&args.scenes, &args.scene_names, &source)?;
+    let mut scenes = load_scenes(&args.scenes, &args.scene_names, &source)?;
+    keep_every(&mut scenes, args.stride);
     if args.simd_ab {
         for scene in &scenes {
             for set in &scene.ray_sets {
-                simd_ab(scene, set, RunOptions { stride, runs: 1 }, args.rounds)?;
+                simd_ab(scene, set, args.rounds)?;
             }
         }
         return Ok(());
@@ -117,9 +116,8 @@ fn main() -> Result<(), Error> {
     );
     for scene in &scenes {
         for set in &scene.ray_sets {
-            let setup = construction_ns(set, stride, args.rounds);
-            let opts = RunOptions { stride, runs: 1 };
-            let row = rounds::run(scene, set, opts, args.rounds, true)?;
+            let setup = construction_ns(set, args.rounds);
+            let row = rounds::run(scene, set, args.rounds, true)?;
             let fastest = row.fastest().map(|o| o.structure);
             for ours in &row.ours {
                 let per_ray = median(&ours.per_ray_mrays);

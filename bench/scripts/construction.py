@@ -18,9 +18,11 @@ which the before build cannot measure (it had no per-ray loop: a caller paid con
 tracing).
 """
 import argparse
+import glob
 import json
 import os
 import platform
+import re
 import statistics
 import subprocess
 import sys
@@ -42,9 +44,19 @@ def cpu_name():
 
 
 # The harness that times construction, spliced from the current host into the before build's
-# trace.rs: `prepare_rays` and the helpers it calls (inserted before it where the before build
-# lacks them), each with the host file it comes from.
+# trace.rs: `prepare_rays`, the helpers it calls, and `every`, which gathers the traced records
+# as the current callers do (each inserted before `prepare_rays` where the before build lacks
+# it), each with the host file it comes from.
 HARNESS = [("prepare_rays", "trace.rs"), ("placeholder", "trace.rs"), ("every", "rayfile.rs")]
+
+# The before build's calls `prepare_rays::<S>(records, stride)`; the current one takes the
+# traced records, gathered first.
+OLD_CALL = re.compile(r"prepare_rays::<(\w+)>\(([^,()]+), ([^()]+)\)")
+
+
+def gather_at_calls(text):
+    """`text` with every two-argument call of `prepare_rays` given `every`'s records instead."""
+    return OLD_CALL.sub(r"prepare_rays::<\1>(&crate::trace::every(\2, \3))", text)
 
 
 def function_span(text, name):
@@ -95,6 +107,12 @@ def build_before(rev, repo):
             old = f.read()
         with open(old_path, "w") as f:
             f.write(splice_harness(current, old, old_path))
+        for path in glob.glob(os.path.join(tree, "host/src/**/*.rs"), recursive=True):
+            with open(path) as f:
+                text = f.read()
+            if OLD_CALL.search(text):
+                with open(path, "w") as f:
+                    f.write(gather_at_calls(text))
         subprocess.run(["cargo", "build", "--release", "-q", "-p", "raykernel-host"],
                        cwd=tree, env={**os.environ, "CARGO_TARGET_DIR": target}, check=True)
     finally:

@@ -61,15 +61,13 @@ struct RefRay {
 }
 
 impl Reference {
-    /// Computes the reference for every `stride`-th record, on `threads` threads (this part
-    /// is not timed).
+    /// Computes the reference for every record, on `threads` threads (this part is not timed).
     ///
     /// # Errors
     /// The kernel's build error if the triangles cannot be built into a BVH.
     pub fn compute(
         tris: &[[[f32; 3]; 3]],
         records: &[RayRecord],
-        stride: usize,
         threads: usize,
     ) -> Result<Self, raykernel::BuildError> {
         let kernel_tris: Vec<Triangle<f32>> = tris.iter().map(|t| Triangle { v: *t }).collect();
@@ -77,11 +75,7 @@ impl Reference {
         let mut ids = vec![0u32; tris.len()];
         let bvh = Bvh::build(&kernel_tris, &mut nodes, &mut ids, BuildOptions::default())?;
         let tris64: Vec<[[f64; 3]; 3]> = tris.iter().map(|t| t.map(|p| p.map(f64::from))).collect();
-        let rays: Vec<Option<RefRay>> = records
-            .iter()
-            .step_by(stride.max(1))
-            .map(RefRay::from_record)
-            .collect();
+        let rays: Vec<Option<RefRay>> = records.iter().map(RefRay::from_record).collect();
         let mut hits = vec![None; rays.len()];
         let chunk = rays.len().div_ceil(threads.max(1)).max(1);
         let (tree_nodes, tree_ids) = (bvh.nodes(), bvh.prim_ids());
@@ -123,7 +117,7 @@ impl Reference {
         self.hits.iter().filter(|h| h.is_some()).count()
     }
 
-    /// Errors of `hits` (one per traced ray, same stride) against the reference.
+    /// Errors of `hits` (one per traced ray, in order) against the reference.
     #[must_use]
     pub fn accuracy(&self, hits: &[HitRecord]) -> Accuracy {
         let mut a = Accuracy {
@@ -357,7 +351,7 @@ mod tests {
             RayRecord::new([5.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
             RayRecord::new([0.0, 0.0, 20.0], [0.0, 0.0, -1.0]),
         ];
-        let r = Reference::compute(&quad(), &rays, 1, 2).unwrap();
+        let r = Reference::compute(&quad(), &rays, 2).unwrap();
         assert_eq!(
             r.hits,
             vec![Some((5.0, 0)), Some((5.0, 0)), None, Some((11.0, 2))]

@@ -255,12 +255,11 @@ impl Drop for Scene<'_> {
     }
 }
 
-/// Every `stride`-th record as Embree's shim reads them: 8 floats each (origin, direction,
-/// tmin, tmax, the ray file's layout), next to each other as the kernel's timed loops read
-/// theirs ([`host::rayfile::every`]).
+/// The records as Embree's shim reads them: 8 floats each (origin, direction, tmin, tmax),
+/// the ray file's layout.
 #[must_use]
-pub fn flat_records(records: &[RayRecord], stride: usize) -> Vec<f32> {
-    host::rayfile::every(records, stride)
+pub fn flat_records(records: &[RayRecord]) -> Vec<f32> {
+    records
         .iter()
         .flat_map(|r| {
             [

@@ -110,13 +110,14 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
     let mut machine = machine::Machine::probe();
     let stride = config.stride.max(1);
     let runs = config.runs.max(1);
-    let opts = ours::RunOptions { stride, runs };
+    let opts = ours::RunOptions { runs };
     eprintln!("bench: {}", machine.line());
     let mut scenes = workload::load_scenes(&config.scenes_dir, &config.scenes, &config.rays)?;
     if let Some(dir) = &config.city_dir {
         eprintln!("bench: the tiled city ({})", dir.display());
         scenes.push(workload::load_city(&config.scenes_dir, dir, &config.rays)?);
     }
+    workload::keep_every(&mut scenes, stride);
     let threads = machine.cores.max(1);
     // Warm-up, untimed: the reference configuration once on the first ray set. Without it the
     // first figure of a run came out 10–20% below the same configuration measured later in
@@ -127,7 +128,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
             scene.name,
             set.kind.name()
         );
-        ours::warm_up(scene, set, opts)?;
+        ours::warm_up(scene, set)?;
     }
     let mut rows = Vec::new();
     let mut references = Vec::new();
@@ -138,7 +139,7 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
             .collect();
         for set in &scene.ray_sets {
             eprintln!(
-                "bench: {} {} ({} rays, stride {stride})",
+                "bench: {} {} ({} rays traced, stride {stride})",
                 scene.name,
                 set.kind.name(),
                 set.records.len()
@@ -152,12 +153,14 @@ pub fn run(config: &BenchConfig) -> Result<(BenchResults, Written), Error> {
             }
             if config.rounds > 0 {
                 eprintln!("bench:   interleaved rounds ({})", config.rounds);
-                round_rows.push(rounds::run(scene, set, opts, config.rounds, config.peers)?);
+                round_rows.push(rounds::run(scene, set, config.rounds, config.peers)?);
             }
-            let reference = accuracy::Reference::compute(&tris, &set.records, stride, threads)
-                .map_err(|source| host::Error::Build {
-                    scene: scene.path.clone(),
-                    source,
+            let reference =
+                accuracy::Reference::compute(&tris, &set.records, threads).map_err(|source| {
+                    host::Error::Build {
+                        scene: scene.path.clone(),
+                        source,
+                    }
                 })?;
             references.push(ReferenceRow {
                 scene: scene.name.clone(),

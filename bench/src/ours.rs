@@ -23,11 +23,9 @@ use std::time::Instant;
 /// The `test` label of the Möller–Trumbore contrast rows.
 pub const MT_TEST: &str = "Möller–Trumbore";
 
-/// Repetitions and ray subset.
+/// Repetitions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RunOptions {
-    /// Trace rays `0, stride, 2·stride, ...`.
-    pub stride: usize,
     /// Full runs (build + trace); figures are medians.
     pub runs: usize,
 }
@@ -119,13 +117,13 @@ pub fn configs_for(triangles: usize) -> Vec<OurConfig> {
 pub fn run(scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Result<Vec<TraceRow>, Error> {
     let tris32 = scene.mesh.kernel_triangles::<f32>(&scene.path)?;
     let mt: Vec<MtTriangle> = tris32.iter().copied().map(MtTriangle).collect();
-    let prepared32 = prepare_rays::<f32>(&set.records, opts.stride);
+    let prepared32 = prepare_rays::<f32>(&set.records);
     // Fixed point may not represent the scene (coordinates beyond ±8192): then no fixed rows.
     let tris_fixed: Option<Vec<Triangle<I16F16>>> =
         scene.mesh.kernel_triangles::<I16F16>(&scene.path).ok();
     let prepared_fixed = tris_fixed
         .as_ref()
-        .map(|_| prepare_rays::<I16F16>(&set.records, opts.stride));
+        .map(|_| prepare_rays::<I16F16>(&set.records));
     let rays = Records {
         all: &set.records,
         opts,
@@ -202,15 +200,15 @@ pub fn run(scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Result<Vec<Tra
 ///
 /// # Errors
 /// As [`run`].
-pub fn warm_up(scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Result<(), Error> {
+pub fn warm_up(scene: &BenchScene, set: &RaySet) -> Result<(), Error> {
     let Some(config) = configs().into_iter().next() else {
         return Ok(());
     };
     let tris32 = scene.mesh.kernel_triangles::<f32>(&scene.path)?;
-    let prepared = prepare_rays::<f32>(&set.records, opts.stride);
+    let prepared = prepare_rays::<f32>(&set.records);
     let rays = Records {
         all: &set.records,
-        opts: RunOptions { runs: 1, ..opts },
+        opts: RunOptions { runs: 1 },
         scene: &scene.path,
     };
     measure(&tris32, &prepared, &rays, &config.accel).map(|_| ())
@@ -269,7 +267,6 @@ pub(crate) fn measure<S: Scalar, P: Primitive<S> + Copy>(
         let pass = Pass {
             prepared,
             records: rays.all,
-            stride: rays.opts.stride.max(1),
             extras,
         };
         let (figures, out) = build_and_visit(prims, &mut arena, rays.scene, config, pass)?;
@@ -299,7 +296,6 @@ pub(crate) fn measure<S: Scalar, P: Primitive<S> + Copy>(
 struct Pass<'p, S: Scalar> {
     prepared: &'p PreparedRays<S>,
     records: &'p [RayRecord],
-    stride: usize,
     extras: bool,
 }
 
@@ -317,7 +313,7 @@ impl<S: Scalar> AccelVisitor<S> for Pass<'_, S> {
     type Output = PassOut;
 
     fn visit<A: Accel<S>>(self, accel: &A) -> PassOut {
-        let (_, per_ray_ms) = trace_closest_per_ray(accel, self.records, self.stride);
+        let (_, per_ray_ms) = trace_closest_per_ray(accel, self.records);
         let (hits, closest_ms) = trace_closest(accel, self.prepared);
         let mut out = PassOut {
             hits,
@@ -331,7 +327,7 @@ impl<S: Scalar> AccelVisitor<S> for Pass<'_, S> {
         if !self.extras {
             return out;
         }
-        let (_, any_per_ray_ms) = occluded_per_ray(accel, self.records, self.stride);
+        let (_, any_per_ray_ms) = occluded_per_ray(accel, self.records);
         out.any_per_ray_ms = any_per_ray_ms;
         let rays = &self.prepared.rays;
         let start = Instant::now();

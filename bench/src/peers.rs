@@ -114,9 +114,7 @@ pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Op
     let tris: Vec<[[f32; 3]; 3]> = (0..scene.mesh.triangle_count())
         .map(|i| scene.mesh.triangle_f32(i))
         .collect();
-    // Converted from the traced records gathered densely, as every timed loop reads them.
-    let dense = host::rayfile::every(&set.records, opts.stride);
-    let records: Vec<&RayRecord> = dense.iter().collect();
+    let records: Vec<&RayRecord> = set.records.iter().collect();
     let runs = opts.runs.max(1);
     let m = match peer {
         Peer::ObvhsBvh2 | Peer::ObvhsCwbvh => obvhs_run(peer, &tris, &records, runs),
@@ -198,8 +196,8 @@ mod embree_peer {
     use host::rayfile::RayRecord;
     use host::trace::median;
 
-    /// `runs` builds at `quality`, each followed by a closest-hit pass over every
-    /// `opts.stride`-th record; any hit once after the last. `None` if Embree cannot make a
+    /// `runs` builds at `quality`, each followed by a closest-hit pass over the records; any
+    /// hit once after the last. `None` if Embree cannot make a
     /// device or refuses the scene.
     pub(super) fn run(
         quality: Quality,
@@ -209,7 +207,7 @@ mod embree_peer {
     ) -> Option<PeerMeasured> {
         let device = Device::new()?;
         let geometry = Geometry::of(mesh);
-        let flat = flat_records(records, opts.stride);
+        let flat = flat_records(records);
         let (mut builds, mut closest) = (Vec::new(), Vec::new());
         let mut m = empty_measured();
         for run in 0..opts.runs.max(1) {

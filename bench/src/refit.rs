@@ -127,7 +127,7 @@ fn measure<S: Scalar>(
         |e: raykernel::bvh::RefitError| Error::Bench(format!("refit {} {mode}: {e}", scene.name));
     let n = before.len();
     let options = BuildOptions::default();
-    let prepared = prepare_rays::<S>(rays, opts.stride);
+    let prepared = prepare_rays::<S>(rays);
 
     // The rebuilt trees over the moved mesh, timed, and their hits.
     let mut rebuild_ms = Vec::new();

@@ -15,7 +15,7 @@
 //! noisy environments").
 
 use crate::error::Error;
-use crate::ours::{mrays, RunOptions};
+use crate::ours::mrays;
 use crate::workload::{BenchScene, RayKind, RaySet};
 use host::rayfile::RayRecord;
 use host::trace::{
@@ -151,20 +151,18 @@ fn config(accel: AccelKind) -> AccelConfig {
     }
 }
 
-/// Runs `rounds` rounds on one ray set (every `opts.stride`-th ray), with the peers this
-/// build has when `with_peers`.
+/// Runs `rounds` rounds on one ray set, with the peers this build has when `with_peers`.
 ///
 /// # Errors
 /// A build the kernel refuses.
 pub fn run(
     scene: &BenchScene,
     set: &RaySet,
-    opts: RunOptions,
     rounds: usize,
     with_peers: bool,
 ) -> Result<RoundsRow, Error> {
     let tris = scene.mesh.kernel_triangles::<f32>(&scene.path)?;
-    let prepared = prepare_rays::<f32>(&set.records, opts.stride);
+    let prepared = prepare_rays::<f32>(&set.records);
     let [first, second] = STRUCTURES.map(config);
     let mut arena = NodeArena::<f32>::for_accel(first.accel, &tris);
     let mut second_arena = NodeArena::<f32>::for_accel(second.accel, &tris);
@@ -172,7 +170,6 @@ pub fn run(
         scene,
         records: &set.records,
         prepared: &prepared,
-        stride: opts.stride.max(1),
         rounds: rounds.max(1),
         with_peers,
     };
@@ -247,7 +244,6 @@ struct Alternate<'p> {
     scene: &'p BenchScene,
     records: &'p [RayRecord],
     prepared: &'p PreparedRays<f32>,
-    stride: usize,
     rounds: usize,
     with_peers: bool,
 }
@@ -265,18 +261,12 @@ impl Alternate<'_> {
     fn run<A: Accel<f32>, B: Accel<f32>>(self, first: &A, second: &B) -> Figures {
         let n = self.prepared.rays.len();
         let mut figures = Figures::default();
-        let inputs = EmbreeInputs::new(self.scene, self.records, self.stride, self.with_peers);
+        let inputs = EmbreeInputs::new(self.scene, self.records, self.with_peers);
         let embree = inputs.build();
         let round = |figures: &mut Figures| {
             let [per_ray_a, per_ray_b] = &mut figures.per_ray;
-            per_ray_a.push(mrays(
-                n,
-                trace_closest_per_ray(first, self.records, self.stride).1,
-            ));
-            per_ray_b.push(mrays(
-                n,
-                trace_closest_per_ray(second, self.records, self.stride).1,
-            ));
+            per_ray_a.push(mrays(n, trace_closest_per_ray(first, self.records).1));
+            per_ray_b.push(mrays(n, trace_closest_per_ray(second, self.records).1));
             if let Some(e) = &embree {
                 figures.embree.push(e.trace());
             }
@@ -288,8 +278,7 @@ impl Alternate<'_> {
             let tris: Vec<[[f32; 3]; 3]> = (0..self.scene.mesh.triangle_count())
                 .map(|i| self.scene.mesh.triangle_f32(i))
                 .collect();
-            let dense = host::rayfile::every(self.records, self.stride);
-            let records: Vec<&RayRecord> = dense.iter().collect();
+            let records: Vec<&RayRecord> = self.records.iter().collect();
             crate::peers::alternate_with_tinybvh(&tris, &records, self.rounds, &mut || {
                 round(&mut figures);
             })
@@ -319,13 +308,13 @@ struct EmbreeInputs {
 
 #[cfg(feature = "embree")]
 impl EmbreeInputs {
-    fn new(scene: &BenchScene, records: &[RayRecord], stride: usize, wanted: bool) -> Self {
+    fn new(scene: &BenchScene, records: &[RayRecord], wanted: bool) -> Self {
         use crate::embree::{flat_records, Device, Geometry};
         Self {
             device: if wanted { Device::new() } else { None },
             geometry: Geometry::of(&scene.mesh),
             flat: if wanted {
-                flat_records(records, stride)
+                flat_records(records)
             } else {
                 Vec::new()
             },
@@ -362,7 +351,7 @@ struct EmbreeInputs;
 
 #[cfg(not(feature = "embree"))]
 impl EmbreeInputs {
-    fn new(_: &BenchScene, _: &[RayRecord], _: usize, _: bool) -> Self {
+    fn new(_: &BenchScene, _: &[RayRecord], _: bool) -> Self {
         Self
     }
 

@@ -214,10 +214,7 @@ fn measure_size<S: Scalar>(
     opts: &ScaleOptions,
 ) -> Result<ScaleRow, Error> {
     let tris = tiled.mesh.kernel_triangles::<S>(path)?;
-    let (p, q) = (
-        prepare_rays::<S>(primary, 1),
-        prepare_rays::<S>(incoherent, 1),
-    );
+    let (p, q) = (prepare_rays::<S>(primary), prepare_rays::<S>(incoherent));
     let config = AccelConfig {
         accel: AccelKind::Bvh(BuildOptions::default()),
         leaf_order: false,

@@ -54,8 +54,17 @@ pub enum RaySource {
 pub struct RaySet {
     /// Which set.
     pub kind: RayKind,
-    /// The records, whole (the benchmark's stride applies later).
+    /// The records: the whole file as loaded, the traced ones after [`keep_every`].
     pub records: Vec<RayRecord>,
+}
+
+/// Keeps in every ray set of `scenes` the records a run at `stride` traces, next to each other
+/// ([`host::rayfile::every`]), so that every timed loop, ours and the peers', reads its records
+/// in order.
+pub fn keep_every(scenes: &mut [BenchScene], stride: usize) {
+    for set in scenes.iter_mut().flat_map(|s| &mut s.ray_sets) {
+        set.records = host::rayfile::every(&set.records, stride);
+    }
 }
 
 /// A scene and its ray sets.

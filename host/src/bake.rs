@@ -277,7 +277,7 @@ fn trace_in<S: BakedScalar>(
     let start = std::time::Instant::now();
     let baked = Baked::<S>::load(bytes)?;
     let load_ms = crate::trace::millis(start);
-    let prepared = prepare_rays::<S>(rays, 1);
+    let prepared = prepare_rays::<S>(rays);
     let (hits, trace_ms) = trace_closest(&baked, &prepared);
     Ok((hits, load_ms, trace_ms, grid_hash(&baked)))
 }

@@ -220,13 +220,14 @@ pub fn parse_rays(bytes: &[u8], path: &Path) -> Result<Vec<RayRecord>, FileError
         .collect())
 }
 
-/// The records a benchmark at `stride` traces (`0, stride, 2·stride, ...`; stride 0 counts
-/// as 1), copied next to each other.
+/// The records a trace at `stride` takes (`0, stride, 2·stride, ...`; stride 0 counts as 1),
+/// copied next to each other.
 ///
-/// Timed loops read these rather than every `stride`-th record in place: at a stride of 8 the
-/// 32-byte records of a ray file are 256 bytes apart, each on its own cache line, and a large
-/// file then costs a memory access per ray that a caller reading its rays in order does not
-/// pay (and that depended on how much of it the code around the loop happened to hide).
+/// Gathered once, before any timing, by whoever owns the records: timed loops then read their
+/// records in order. Read in place at a stride of 8, the 32-byte records of a ray file are 256
+/// bytes apart, each on its own cache line, and a large file costs a memory access per ray
+/// that a caller reading its rays in order does not pay (and that depended on how much of it
+/// the code around the loop happened to hide).
 #[must_use]
 pub fn every(rays: &[RayRecord], stride: usize) -> Vec<RayRecord> {
     rays.iter().step_by(stride.max(1)).copied().collect()

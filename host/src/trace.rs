@@ -203,15 +203,18 @@ fn trace_in<S: Scalar>(
     rays: &[RayRecord],
     config: &TraceConfig,
 ) -> Result<TraceOutput, Error> {
+    assert!(config.stride > 0, "stride must be at least 1");
     assert!(config.runs > 0, "runs must be at least 1");
     let tris = mesh.kernel_triangles::<S>(scene)?;
     let mut arena = NodeArena::<S>::for_accel(config.accel, &tris);
+    // The traced records, gathered once (see `every`).
+    let rays = every(rays, config.stride);
     let mut first: Option<Vec<HitRecord>> = None;
     let mut last = None;
     let (mut build_ms_runs, mut trace_ms_runs) = (Vec::new(), Vec::new());
     let (mut setup_ms_runs, mut per_ray_ms_runs) = (Vec::new(), Vec::new());
     for run in 0..config.runs {
-        let (hits, stats) = run_once(&tris, &mut arena, scene, rays, config)?;
+        let (hits, stats) = run_once(&tris, &mut arena, scene, &rays, config)?;
         if let Some(first) = &first {
             if let Some(ray) = first_difference(first, &hits) {
                 return Err(Error::RunsDiffer {
@@ -244,8 +247,8 @@ fn trace_in<S: Scalar>(
     Ok(TraceOutput { hits, stats })
 }
 
-/// One run: build (timed), trace constructing each ray in the loop (timed), then prepare the
-/// rays (timed) and trace them again (timed).
+/// One run over the traced records `rays`: build (timed), trace constructing each ray in the
+/// loop (timed), then prepare the rays (timed) and trace them again (timed).
 fn run_once<S: Scalar>(
     tris: &[Triangle<S>],
     arena: &mut NodeArena<S>,
@@ -255,18 +258,14 @@ fn run_once<S: Scalar>(
 ) -> Result<(Vec<HitRecord>, TraceStats), Error> {
     struct Closest<'r> {
         rays: &'r [RayRecord],
-        stride: usize,
     }
     impl<S: Scalar> AccelVisitor<S> for Closest<'_> {
         type Output = (Vec<HitRecord>, TraceStats);
         fn visit<A: Accel<S>>(self, accel: &A) -> Self::Output {
-            trace_rays(accel, self.rays, self.stride)
+            trace_rays(accel, self.rays)
         }
     }
-    let visitor = Closest {
-        rays,
-        stride: config.stride,
-    };
+    let visitor = Closest { rays };
     let (built, (hits, stats)) =
         build_and_visit(tris, arena, scene, &config.accel_config(), visitor)?;
     let stats = TraceStats {
@@ -412,15 +411,14 @@ impl<S: Scalar> NodeArena<S> {
     }
 }
 
-/// Traces every `stride`-th ray both ways (constructed in the loop, then pre-built); fills in
-/// the ray, hit and timing figures. Both ways give the same hits.
+/// Traces every record both ways (constructed in the loop, then pre-built); fills in the ray,
+/// hit and timing figures. Both ways give the same hits.
 fn trace_rays<S: Scalar, A: Accel<S>>(
     accel: &A,
     rays: &[RayRecord],
-    stride: usize,
 ) -> (Vec<HitRecord>, TraceStats) {
-    let (per_ray_hits, per_ray_ms) = trace_closest_per_ray(accel, rays, stride);
-    let prepared = prepare_rays::<S>(rays, stride);
+    let (per_ray_hits, per_ray_ms) = trace_closest_per_ray(accel, rays);
+    let prepared = prepare_rays::<S>(rays);
     let (hits, trace_ms) = trace_closest(accel, &prepared);
     debug_assert!(
         first_difference(&hits, &per_ray_hits).is_none(),
@@ -438,26 +436,20 @@ fn trace_rays<S: Scalar, A: Accel<S>>(
     (hits, stats)
 }
 
-/// Closest hit of every `stride`-th record: one kernel ray, set from each record's raw origin,
-/// direction and interval ([`Ray::set_from_f32`], in place) inside the timed loop, then
-/// traced: what a caller pays per query. The loop reads the traced records gathered densely
-/// ([`every`], untimed). A record the kernel rejects is a miss. Returns the hits and the
-/// loop's wall time, ms.
-///
-/// # Panics
-/// If `stride` is 0.
+/// Closest hit of every record, read in order (a subset is gathered first: [`every`]): one
+/// kernel ray, set from each record's raw origin, direction and interval
+/// ([`Ray::set_from_f32`], in place) inside the timed loop, then traced: what a caller pays
+/// per query. A record the kernel rejects is a miss. Returns the hits and the loop's wall
+/// time, ms.
 #[must_use]
 pub fn trace_closest_per_ray<S: Scalar, A: Accel<S>>(
     accel: &A,
     rays: &[RayRecord],
-    stride: usize,
 ) -> (Vec<HitRecord>, f64) {
-    assert!(stride > 0, "stride must be at least 1");
-    let rays = every(rays, stride);
     let mut hits = vec![HitRecord::MISS; rays.len()];
     let mut ray = placeholder::<S>();
     let start = Instant::now();
-    for (slot, r) in hits.iter_mut().zip(&rays) {
+    for (slot, r) in hits.iter_mut().zip(rays) {
         if ray.set_from_f32(r.origin, r.dir, r.t_min, r.t_max).is_err() {
             continue;
         }
@@ -471,24 +463,15 @@ pub fn trace_closest_per_ray<S: Scalar, A: Accel<S>>(
     (hits, millis(start))
 }
 
-/// Any hit (occlusion) of every `stride`-th record, the kernel ray set from each record inside
-/// the timed loop (over the traced records gathered densely) as in [`trace_closest_per_ray`]. Returns how many are occluded and the loop's
-/// wall time, ms.
-///
-/// # Panics
-/// If `stride` is 0.
+/// Any hit (occlusion) of every record, the kernel ray set from each record inside the timed
+/// loop as in [`trace_closest_per_ray`]. Returns how many are occluded and the loop's wall
+/// time, ms.
 #[must_use]
-pub fn occluded_per_ray<S: Scalar, A: Accel<S>>(
-    accel: &A,
-    rays: &[RayRecord],
-    stride: usize,
-) -> (usize, f64) {
-    assert!(stride > 0, "stride must be at least 1");
-    let rays = every(rays, stride);
+pub fn occluded_per_ray<S: Scalar, A: Accel<S>>(accel: &A, rays: &[RayRecord]) -> (usize, f64) {
     let mut ray = placeholder::<S>();
     let start = Instant::now();
     let mut occluded = 0usize;
-    for r in &rays {
+    for r in rays {
         if ray.set_from_f32(r.origin, r.dir, r.t_min, r.t_max).is_ok() {
             occluded += usize::from(accel.occluded(&ray));
         }
@@ -517,25 +500,20 @@ pub struct PreparedRays<S: Scalar> {
     pub setup_ms: f64,
 }
 
-/// Turns every `stride`-th record into a kernel ray (timed, over the records gathered densely
-/// as in [`trace_closest_per_ray`]).
-///
-/// # Panics
-/// If `stride` is 0.
+/// Turns every record into a kernel ray (timed), reading them in order as
+/// [`trace_closest_per_ray`] does.
 #[must_use]
-pub fn prepare_rays<S: Scalar>(rays: &[RayRecord], stride: usize) -> PreparedRays<S> {
-    assert!(stride > 0, "stride must be at least 1");
+pub fn prepare_rays<S: Scalar>(rays: &[RayRecord]) -> PreparedRays<S> {
     // Rejected records (bad rays) are traced as a placeholder and written as misses. The
     // placeholder is a valid ray in both modes, so `prepared` keeps one entry per record.
     // The vector is filled with it before the clock starts, and each ray is then written in
     // place: the fill takes the page faults of fresh memory (most of the time of storing
     // 100+ bytes per ray), which are not ray construction. (One exact-size allocation:
     // growing a 100+ MB vector by reallocation measurably slowed the trace that follows.)
-    let rays = every(rays, stride);
     let mut prepared = vec![placeholder::<S>(); rays.len()];
     let mut bad = Vec::new();
     let start = Instant::now();
-    for (i, (slot, r)) in prepared.iter_mut().zip(&rays).enumerate() {
+    for (i, (slot, r)) in prepared.iter_mut().zip(rays).enumerate() {
         match Ray::<S>::from_f32(r.origin, r.dir, r.t_min, r.t_max) {
             Ok(ray) => *slot = ray,
             Err(_) => bad.push(i),
