@@ -132,17 +132,25 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
                         }
                         if others & (others - 1) == 0 {
                             // Two: visit the nearer (the first on a tie), push the other.
-                            // Slots by index here: a jump over the 28 pairs helps coherent rays
-                            // but mispredicts on incoherent ones, which then lose more.
-                            let first = slot(hit.trailing_zeros());
-                            let second = slot(others.trailing_zeros());
-                            let (near, far) = if second.2 < first.2 {
-                                (second, first)
+                            // The nearer reached by branch again (a jump over its slot); a jump
+                            // over the 28 pairs instead mispredicts on incoherent rays.
+                            let (i, j) = (hit.trailing_zeros(), others.trailing_zeros());
+                            let (near, far) = if t[j as usize % 8] < t[i as usize % 8] {
+                                (j, i)
                             } else {
-                                (first, second)
+                                (i, j)
                             };
-                            let _ = stack.push(far);
-                            (child, count) = (near.0, near.1);
+                            let _ = stack.push(slot(far));
+                            (child, count) = match near {
+                                0 => (node.child[0], node.count[0]),
+                                1 => (node.child[1], node.count[1]),
+                                2 => (node.child[2], node.count[2]),
+                                3 => (node.child[3], node.count[3]),
+                                4 => (node.child[4], node.count[4]),
+                                5 => (node.child[5], node.count[5]),
+                                6 => (node.child[6], node.count[6]),
+                                _ => (node.child[7], node.count[7]),
+                            };
                             continue 'walk;
                         }
                         // Three or more: insertion into nearest-first order (the first of
