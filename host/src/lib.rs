@@ -21,7 +21,7 @@
 //! - [`console`]: lines for people (summaries, warnings, progress) apart from the report,
 //! - [`output`]: output files checked and reserved before the work,
 //! - [`error`]: the error type `main` turns into a message and an exit code.
-#![forbid(unsafe_code)]
+#![deny(unsafe_code)]
 
 pub mod bake;
 pub mod check;
@@ -37,6 +37,7 @@ pub mod limits;
 pub mod mtl;
 pub mod obj;
 pub mod output;
+pub mod pages;
 pub mod rayfile;
 pub mod render;
 pub mod scene;

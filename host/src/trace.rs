@@ -14,6 +14,7 @@
 
 use crate::error::Error;
 use crate::obj::Mesh;
+use crate::pages;
 use crate::rayfile::{every, HitRecord, RayRecord};
 use raykernel::bvh::BuilderKind;
 use raykernel::{
@@ -298,7 +299,7 @@ pub fn build_and_visit<S: Scalar, P: Primitive<S> + Copy, V: AccelVisitor<S>>(
     // The leaf-order permutation works in place: give it a fresh copy (untimed, like parsing).
     let leaf_order = config.leaf_order && config.accel.permutes_into_leaf_order();
     let mut own = if leaf_order {
-        prims.to_vec()
+        pages::copied(prims)
     } else {
         Vec::new()
     };
@@ -374,11 +375,11 @@ impl<S: Scalar> NodeArena<S> {
     #[must_use]
     pub fn sized(need: raykernel::MemoryNeeded) -> Self {
         Self {
-            nodes: vec![Node::EMPTY; need.nodes + 1],
-            nodes4: vec![Node4::EMPTY; need.nodes4],
-            nodes8: vec![Node8::EMPTY; need.nodes8],
-            kd_nodes: vec![KdNode::EMPTY; need.kd_nodes],
-            words: vec![0; need.words],
+            nodes: pages::filled(need.nodes + 1, Node::EMPTY),
+            nodes4: pages::filled(need.nodes4, Node4::EMPTY),
+            nodes8: pages::filled(need.nodes8, Node8::EMPTY),
+            kd_nodes: pages::filled(need.kd_nodes, KdNode::EMPTY),
+            words: pages::filled(need.words, 0),
         }
     }
 
