@@ -133,7 +133,9 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
                         if others & (others - 1) == 0 {
                             // Two: visit the nearer (the first on a tie), push the other.
                             // The nearer reached by branch again (a jump over its slot); a jump
-                            // over the 28 pairs instead mispredicts on incoherent rays.
+                            // over the 28 pairs instead mispredicts on incoherent rays. (Written
+                            // out here and above: one closure for both sites compiled to an
+                            // index, without the jumps.)
                             let (i, j) = (hit.trailing_zeros(), others.trailing_zeros());
                             let (near, far) = if t[j as usize % 8] < t[i as usize % 8] {
                                 (j, i)
