@@ -1382,10 +1382,22 @@ fn scale_section(s: &mut String, r: &BenchResults) {
     );
 }
 
+/// The machine's transparent-huge-page mode (Linux: the bracketed word of
+/// `/sys/kernel/mm/transparent_hugepage/enabled`), or what stands in for it.
+fn huge_page_mode() -> String {
+    std::fs::read_to_string("/sys/kernel/mm/transparent_hugepage/enabled")
+        .ok()
+        .and_then(|m| Some(m.split_once('[')?.1.split_once(']')?.0.to_owned()))
+        .unwrap_or_else(|| "none (no transparent huge pages)".to_owned())
+}
+
 fn notes_section(s: &mut String) {
     let _ = writeln!(
         s,
         "## Method\n\n\
+         - Memory: ours allocates its node arenas and the leaf-order copy of the triangles \
+         before writing them and, on Linux, advises them for transparent huge pages \
+         (`host::pages`), as Embree's allocator advises its BVH; this machine's mode: `{}`.\n\
          - Build: wall time of the call that turns the triangle array into the structure \
          that is traversed (ours: `Bvh::build` into a 64-byte aligned arena, then the 4-wide \
          collapse; Embree: `rtcNewScene`, one triangle geometry over shared vertex and index \
@@ -1410,7 +1422,7 @@ fn notes_section(s: &mut String) {
          copies, counted in the blocks it reserves); obvhs and tinybvh, nodes and primitive \
          indices; bvh, nodes only. The triangles themselves are not counted.\n\
          - The city (`make_tiled.py`, 1.2M triangles) runs the headline configurations of ours \
-         only (4-wide BVH from the SAH BVH, both modes), with every peer.\n\
+         only (the 4-wide and the 8-wide BVH from the SAH BVH, both modes), with every peer.\n\
          - `data.json`'s `figures` holds one row per scene, ray set, contender and figure; \
          `bench/scripts/ratios.py data.json` recomputes the headline and round ratios from \
          them.\n\
@@ -1418,6 +1430,7 @@ fn notes_section(s: &mut String) {
          traversal): `cargo bench -p raykernel-bench --bench hot`.\n\
          - The interleaved rounds alone, with ray construction timed apart, for A/B work on the \
          headline structure (seconds per scene): `cargo run --release -p raykernel-bench \
-         --features embree --example rounds -- --rays RAYS_DIR`.\n"
+         --features embree --example rounds -- --rays RAYS_DIR`.\n",
+        huge_page_mode()
     );
 }
