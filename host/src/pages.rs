@@ -9,6 +9,7 @@
 //! are plain vectors.
 
 /// The huge page size asked for (x86-64 and most aarch64 Linux kernels).
+#[cfg_attr(not(target_os = "linux"), allow(dead_code))]
 const HUGE_PAGE: usize = 2 << 20;
 
 /// `len` copies of `value`, in a buffer asked for huge pages if it spans one.
