@@ -125,7 +125,7 @@ pub fn run(scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Result<Vec<Tra
         .as_ref()
         .map(|_| prepare_rays::<I16F16>(&set.records));
     let rays = Records {
-        all: &set.records,
+        traced: &set.records,
         opts,
         scene: &scene.path,
     };
@@ -207,7 +207,7 @@ pub fn warm_up(scene: &BenchScene, set: &RaySet) -> Result<(), Error> {
     let tris32 = scene.mesh.kernel_triangles::<f32>(&scene.path)?;
     let prepared = prepare_rays::<f32>(&set.records);
     let rays = Records {
-        all: &set.records,
+        traced: &set.records,
         opts: RunOptions { runs: 1 },
         scene: &scene.path,
     };
@@ -224,9 +224,9 @@ pub fn mrays(rays: usize, ms: f64) -> f64 {
     }
 }
 
-/// The records of one ray set, which of them to trace, how often, and the scene (for errors).
+/// The traced records of one ray set, how often to trace them, and the scene (for errors).
 pub(crate) struct Records<'r> {
-    pub(crate) all: &'r [RayRecord],
+    pub(crate) traced: &'r [RayRecord],
     pub(crate) opts: RunOptions,
     pub(crate) scene: &'r Path,
 }
@@ -266,7 +266,7 @@ pub(crate) fn measure<S: Scalar, P: Primitive<S> + Copy>(
         let extras = run + 1 == runs;
         let pass = Pass {
             prepared,
-            records: rays.all,
+            records: rays.traced,
             extras,
         };
         let (figures, out) = build_and_visit(prims, &mut arena, rays.scene, config, pass)?;

@@ -15,8 +15,7 @@ const HUGE_PAGE: usize = 2 << 20;
 /// `len` copies of `value`, in a buffer asked for huge pages if it spans one.
 #[must_use]
 pub fn filled<T: Clone>(len: usize, value: T) -> Vec<T> {
-    let mut v = Vec::with_capacity(len);
-    advise_huge_pages(&v);
+    let mut v = advised(len);
     v.resize(len, value);
     v
 }
@@ -24,9 +23,15 @@ pub fn filled<T: Clone>(len: usize, value: T) -> Vec<T> {
 /// A copy of `xs`, in a buffer asked for huge pages if it spans one.
 #[must_use]
 pub fn copied<T: Clone>(xs: &[T]) -> Vec<T> {
-    let mut v = Vec::with_capacity(xs.len());
-    advise_huge_pages(&v);
+    let mut v = advised(xs.len());
     v.extend_from_slice(xs);
+    v
+}
+
+/// An empty vector with room for `len` values, its buffer advised before anything touches it.
+fn advised<T>(len: usize) -> Vec<T> {
+    let v = Vec::with_capacity(len);
+    advise_huge_pages(&v);
     v
 }
 
