@@ -18,8 +18,8 @@ use crate::pages;
 use crate::rayfile::{every, HitRecord, RayRecord};
 use raykernel::bvh::BuilderKind;
 use raykernel::{
-    Accel, AccelKind, AccelMemory, AccelVisitor, AnyAccel, KdNode, Node, Node4, Node8, Primitive,
-    Ray, Scalar, Triangle, I16F16,
+    Accel, AccelKind, AccelMemory, AccelVisitor, AnyAccel, Coherent, KdNode, Node, Node4, Node8,
+    Primitive, Ray, Scalar, Triangle, I16F16,
 };
 use std::path::Path;
 use std::time::Instant;
@@ -91,6 +91,9 @@ pub struct TraceConfig {
     /// Build with [`Bvh::build_in_leaf_order`] (primitives permuted into leaf order; hits
     /// still report original ids). Ignored by [`AccelKind::Linear`].
     pub leaf_order: bool,
+    /// Query through [`raykernel::Coherent`]: the walk for coherent rays (camera rays in
+    /// scanline order), where the structure has one. Same hits.
+    pub coherent: bool,
 }
 
 impl TraceConfig {
@@ -259,14 +262,22 @@ fn run_once<S: Scalar>(
 ) -> Result<(Vec<HitRecord>, TraceStats), Error> {
     struct Closest<'r> {
         rays: &'r [RayRecord],
+        coherent: bool,
     }
     impl<S: Scalar> AccelVisitor<S> for Closest<'_> {
         type Output = (Vec<HitRecord>, TraceStats);
         fn visit<A: Accel<S>>(self, accel: &A) -> Self::Output {
-            trace_rays(accel, self.rays)
+            if self.coherent {
+                trace_rays(&Coherent(accel), self.rays)
+            } else {
+                trace_rays(accel, self.rays)
+            }
         }
     }
-    let visitor = Closest { rays };
+    let visitor = Closest {
+        rays,
+        coherent: config.coherent,
+    };
     let (built, (hits, stats)) =
         build_and_visit(tris, arena, scene, &config.accel_config(), visitor)?;
     let stats = TraceStats {

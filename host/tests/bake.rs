@@ -68,6 +68,7 @@ fn check_scene(obj: &Path, rays: &Path, dir: &Path) {
                 stride: 1,
                 runs: 1,
                 leaf_order: false,
+                coherent: false,
             })
             .unwrap_or_else(|e| panic!("{case}: trace: {e}"));
             let baked_hits = dir.join("baked.hits");

@@ -104,6 +104,7 @@ fn args(s: &Scene, accel: AccelKind, builder: Builder, mode: Mode, leaf: u32) ->
         stride: 1,
         runs: 1,
         leaf_order: false,
+        coherent: false,
     }
 }
 
@@ -299,6 +300,38 @@ fn bvh4_matches_brute_force_byte_for_byte() {
                     let got = report.bytes_per_tri * report.triangles as f64;
                     assert!((got - expected).abs() <= 1e-9 * expected, "{report:?}");
                 }
+            }
+        }
+    }
+}
+
+/// The 8-wide BVH writes the bytes brute force writes, by its default walk and by its walk for
+/// coherent rays (`--coherent`), in leaf order and not, and the report says which walk ran.
+#[test]
+fn bvh8_matches_brute_force_by_both_walks() {
+    let s = scene("end_to_end_bvh8");
+    for mode in [Mode::F32, Mode::Fixed] {
+        let (_, reference) = run(&args(&s, AccelKind::Linear, Builder::Sah, mode, 4));
+        for coherent in [false, true] {
+            for leaf_order in [false, true] {
+                let mut a = args(
+                    &s,
+                    AccelKind::Bvh8(BuildOptions::DEFAULT),
+                    Builder::Sah,
+                    mode,
+                    3,
+                );
+                a.leaf_order = leaf_order;
+                a.coherent = coherent;
+                a.out = s
+                    .dir
+                    .join(format!("bvh8.{mode:?}.{coherent}.{leaf_order}.hits"));
+                let (report, bytes) = run(&a);
+                assert!(
+                    bytes == reference,
+                    "{mode:?} coherent {coherent} leaf order {leaf_order}: bvh8 differs"
+                );
+                assert_eq!((report.accel, report.coherent), ("bvh8", coherent));
             }
         }
     }

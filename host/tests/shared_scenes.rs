@@ -53,6 +53,7 @@ fn bunny_bvh_matches_brute_force_for_every_builder_and_mode() {
             stride: 1,
             runs: 1,
             leaf_order: false,
+            coherent: false,
         };
         let linear = trace(
             &mesh,
@@ -90,6 +91,18 @@ fn bunny_bvh_matches_brute_force_for_every_builder_and_mode() {
             assert!(
                 encode_hits(&other.hits) == reference,
                 "{mode:?} {accel:?}: differs from linear"
+            );
+        }
+        // The 8-wide tree by both of its walks.
+        for coherent in [false, true] {
+            let wide = TraceConfig {
+                coherent,
+                ..config(AccelKind::Bvh8(BuildOptions::DEFAULT), BuilderKind::Sah)
+            };
+            let other = trace(&mesh, &obj, &rays, &wide).unwrap();
+            assert!(
+                encode_hits(&other.hits) == reference,
+                "{mode:?} bvh8 (coherent walk: {coherent}): differs from linear"
             );
         }
     }

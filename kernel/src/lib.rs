@@ -57,7 +57,7 @@ pub use accel::kdtree::{KdNode, KdTree};
 pub use accel::wide::{Bvh4, Bvh8, Node4, Node8, WideBvh, WideNode};
 pub use accel::{
     Accel, AccelFamily, AccelKind, AccelMemory, AccelVisitor, AnyAccel, AnyFamily, Arena,
-    BuildError, Bvh4Family, Bvh8Family, BvhFamily, Counters, GridFamily, InvalidAccel,
+    BuildError, Bvh4Family, Bvh8Family, BvhFamily, Coherent, Counters, GridFamily, InvalidAccel,
     KdTreeFamily, Linear, LinearFamily, MemoryNeeded, Nearest, NoStats, Shortfall, TraversalStats,
     TrianglesOnly, UnknownAccel, MAX_PRIMS,
 };

@@ -11,7 +11,7 @@
 //! - the collapse, for both widths: arena sizes (`wide_nodes_needed` bounds every collapse and
 //!   is reached, one slot less is a typed error), its values and growth, empty and
 //!   one-primitive scenes, leaf order, and a deeper tree (a 5120-triangle sphere) answering
-//!   like the BVH2 and brute force bit for bit in both modes;
+//!   like the BVH2 and brute force bit for bit in both modes, by both walks (`Coherent`);
 //! - the same through `AnyAccel` (`AccelKind::Bvh4`, `AccelKind::Bvh8`), built as is and in
 //!   leaf order into exactly the memory `AccelKind::memory_needed` gives.
 
@@ -26,8 +26,8 @@ use raykernel::bvh4::nodes4_needed;
 use raykernel::bvh8::{collapse_words_needed, nodes8_needed, wide_nodes_needed};
 use raykernel::Arena;
 use raykernel::{
-    Aabb, Accel, AccelKind, AnyAccel, BuildError, Bvh, Linear, Node, Ray, Triangle, WideBvh,
-    WideNode, I16F16,
+    Aabb, Accel, AccelKind, AnyAccel, BuildError, Bvh, Coherent, Linear, Node, Ray, Triangle,
+    WideBvh, WideNode, I16F16,
 };
 use raykernel_testkit::icosphere::unit_icosphere;
 use raykernel_testkit::memory::OwnedMemory;
@@ -685,6 +685,8 @@ where
                     for (r, w) in rays.iter().zip(&want) {
                         let got = query(wide, &r.ray::<S>()).unwrap();
                         same_hit(&got, w).unwrap_or_else(|e| panic!("{}", ctx("", e, r)));
+                        let got = query(&Coherent(wide), &r.ray::<S>()).unwrap();
+                        same_hit(&got, w).unwrap_or_else(|e| panic!("{}", ctx(" coherent", e, r)));
                     }
                 });
             });
@@ -754,6 +756,8 @@ fn any_accel_cases<S: TestScalar>() {
             for (r, w) in rays.iter().zip(&want) {
                 let got = query(&accel, &r.ray::<S>()).unwrap();
                 same_hit(&got, w).unwrap_or_else(|e| panic!("{ctx}: {e}, ray {r}"));
+                let got = query(&Coherent(&accel), &r.ray::<S>()).unwrap();
+                same_hit(&got, w).unwrap_or_else(|e| panic!("{ctx} coherent: {e}, ray {r}"));
             }
             assert_eq!(own != tris, leaf_order, "{ctx}: primitives permuted");
         }

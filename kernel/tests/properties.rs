@@ -3,7 +3,7 @@
 //! - the tree passes `validate()` after every build (and respects the leaf size);
 //! - the BVH's closest hit equals brute force (`Linear`) bit for bit: t, primitive, u and v;
 //! - so do those of the 4-wide and the 8-wide BVH collapsed from each tree (validated, within
-//!   `nodes4_needed` / `nodes8_needed`);
+//!   `nodes4_needed` / `nodes8_needed`), queried directly and through `Coherent`;
 //! - so do the uniform grid's (densities 0.25, 2 and 8, each built into arenas of exactly the
 //!   counted size and validated) and the kd-tree's (automatic depth, depth 3 and the maximum,
 //!   built into the documented budgets and validated);
@@ -27,8 +27,8 @@ use proptest::test_runner::{Config as ProptestConfig, RngSeed};
 use raykernel::bvh::BuildOptions;
 use raykernel::bvh8::wide_nodes_needed;
 use raykernel::{
-    grid::GridOptions, kdtree::KdOptions, Accel, AccelKind, Bvh, Linear, Primitive, Sphere,
-    Triangle, WideBvh, I16F16,
+    grid::GridOptions, kdtree::KdOptions, Accel, AccelKind, Bvh, Coherent, Linear, Primitive,
+    Sphere, Triangle, WideBvh, I16F16,
 };
 
 const SEED: u64 = 0x5eed_7a11_0001;
@@ -408,6 +408,11 @@ where
             let got =
                 query(wide, &r.ray::<S>()).map_err(|e| ctx(format!("{name} {e}, ray {r}")))?;
             same_hit(&got, want).map_err(|e| ctx(format!("{name} vs Linear: {e}, ray {r}")))?;
+            // The walk for coherent rays answers alike.
+            let got = query(&Coherent(wide), &r.ray::<S>())
+                .map_err(|e| ctx(format!("{name} coherent {e}, ray {r}")))?;
+            same_hit(&got, want)
+                .map_err(|e| ctx(format!("{name} coherent vs Linear: {e}, ray {r}")))?;
         }
         Ok(())
     })

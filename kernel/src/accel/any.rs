@@ -241,6 +241,26 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for AnyAccel<'_, S, P> {
     }
 
     #[inline]
+    fn nearest_coherent_counted<C: Counters>(
+        &self,
+        ray: &Ray<S>,
+        stats: &mut C,
+    ) -> Option<Nearest<S>> {
+        match self {
+            Self::Bvh8(a) => a.nearest_coherent_counted(ray, stats),
+            _ => self.nearest_counted(ray, stats),
+        }
+    }
+
+    #[inline]
+    fn occluded_coherent_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> bool {
+        match self {
+            Self::Bvh8(a) => a.occluded_coherent_counted(ray, stats),
+            _ => self.occluded_counted(ray, stats),
+        }
+    }
+
+    #[inline]
     fn barycentrics(&self, ray: &Ray<S>, found: &Nearest<S>) -> Barycentrics<S> {
         match self {
             Self::Linear(a) => a.barycentrics(ray, found),

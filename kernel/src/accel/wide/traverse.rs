@@ -57,9 +57,10 @@ fn sort_nearest_first<S: Scalar>(e: &mut [Entry<S>; 4], n: usize) {
 /// A wide tree's walk, written per width.
 pub(super) trait Walk<S: Scalar> {
     /// Walks the tree. With `ANY`, returns at the first hit in range; otherwise finds the
-    /// closest under [`closer`]. Returns (t, prim id, index into `prims`) of the hit;
+    /// closest under [`closer`]. `COHERENT`: the walk for coherent rays where the width has
+    /// one ([`crate::Coherent`]). Returns (t, prim id, index into `prims`) of the hit;
     /// `prim id == u32::MAX` for none.
-    fn traverse<const ANY: bool, C: Counters>(
+    fn traverse<const ANY: bool, const COHERENT: bool, C: Counters>(
         &self,
         ray: &Ray<S>,
         stats: &mut C,
@@ -67,9 +68,10 @@ pub(super) trait Walk<S: Scalar> {
 }
 
 impl<S: Scalar, P: Primitive<S>> Walk<S> for Bvh4<'_, S, P> {
-    /// Runs the copy of [`Bvh4::walk`] that [`crate::cpu`] selects.
+    /// Runs the copy of [`Bvh4::walk`] that [`crate::cpu`] selects. One walk serves both kinds
+    /// of rays: it already reaches the nearer of two hit children by a jump over the pairs.
     #[inline(always)]
-    fn traverse<const ANY: bool, C: Counters>(
+    fn traverse<const ANY: bool, const COHERENT: bool, C: Counters>(
         &self,
         ray: &Ray<S>,
         stats: &mut C,
@@ -237,7 +239,7 @@ where
 {
     #[inline]
     fn nearest_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> Option<Nearest<S>> {
-        let (t, prim, slot) = self.traverse::<false, C>(ray, stats);
+        let (t, prim, slot) = self.traverse::<false, false, C>(ray, stats);
         Nearest::found(t, prim, slot)
     }
 
@@ -247,6 +249,21 @@ where
 
     #[inline]
     fn occluded_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> bool {
-        self.traverse::<true, C>(ray, stats).1 != u32::MAX
+        self.traverse::<true, false, C>(ray, stats).1 != u32::MAX
+    }
+
+    #[inline]
+    fn nearest_coherent_counted<C: Counters>(
+        &self,
+        ray: &Ray<S>,
+        stats: &mut C,
+    ) -> Option<Nearest<S>> {
+        let (t, prim, slot) = self.traverse::<false, true, C>(ray, stats);
+        Nearest::found(t, prim, slot)
+    }
+
+    #[inline]
+    fn occluded_coherent_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> bool {
+        self.traverse::<true, true, C>(ray, stats).1 != u32::MAX
     }
 }

@@ -24,7 +24,7 @@ type Entry<S> = (u32, u32, S);
 impl<S: Scalar, P: Primitive<S>> Walk<S> for Bvh8<'_, S, P> {
     /// Runs the copy of [`Bvh8::walk8`] that [`crate::cpu`] selects.
     #[inline(always)]
-    fn traverse<const ANY: bool, C: Counters>(
+    fn traverse<const ANY: bool, const COHERENT: bool, C: Counters>(
         &self,
         ray: &Ray<S>,
         stats: &mut C,
@@ -33,23 +33,22 @@ impl<S: Scalar, P: Primitive<S>> Walk<S> for Bvh8<'_, S, P> {
         if crate::cpu::avx2() {
             #[allow(unsafe_code)]
             // SAFETY: `cpu::avx2` is true only on a CPU with every feature `walk8_avx2` enables.
-            return unsafe { self.walk8_avx2::<ANY, C>(ray, stats) };
+            return unsafe { self.walk8_avx2::<ANY, COHERENT, C>(ray, stats) };
         }
-        self.walk8_baseline::<ANY, C>(ray, stats)
+        self.walk8_baseline::<ANY, COHERENT, C>(ray, stats)
     }
 }
 
 impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
     /// [`Bvh8::walk8`] as compiled for the target (in 256-bit lanes if the target has AVX2).
     #[inline(never)]
-    fn walk8_baseline<const ANY: bool, C: Counters>(
+    fn walk8_baseline<const ANY: bool, const COHERENT: bool, C: Counters>(
         &self,
         ray: &Ray<S>,
         stats: &mut C,
     ) -> (S, u32, usize) {
-        self.walk8::<ANY, C, { cfg!(all(target_arch = "x86_64", target_feature = "avx2")) }>(
-            ray, stats,
-        )
+        const AVX: bool = cfg!(all(target_arch = "x86_64", target_feature = "avx2"));
+        self.walk8::<ANY, COHERENT, C, AVX>(ray, stats)
     }
 
     /// [`Bvh8::walk8`] compiled for AVX2, its box tests in 256-bit lanes (see [`crate::cpu`]).
@@ -59,18 +58,19 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
     #[cfg(all(target_arch = "x86_64", not(target_feature = "avx2")))]
     #[allow(unsafe_code)]
     #[target_feature(enable = "avx,avx2,bmi1,bmi2,lzcnt,popcnt")]
-    unsafe fn walk8_avx2<const ANY: bool, C: Counters>(
+    unsafe fn walk8_avx2<const ANY: bool, const COHERENT: bool, C: Counters>(
         &self,
         ray: &Ray<S>,
         stats: &mut C,
     ) -> (S, u32, usize) {
-        self.walk8::<ANY, C, true>(ray, stats)
+        self.walk8::<ANY, COHERENT, C, true>(ray, stats)
     }
 
-    /// The traversal itself, inlined into each compiled copy. `AVX`: test the boxes with
+    /// The traversal itself, inlined into each compiled copy. `COHERENT`: the walk for
+    /// coherent rays (see [`crate::Coherent`]). `AVX`: test the boxes with
     /// `Numerics::slab8_avx2`; set only in copies that run on a CPU with AVX2.
     #[inline(always)]
-    fn walk8<const ANY: bool, C: Counters, const AVX: bool>(
+    fn walk8<const ANY: bool, const COHERENT: bool, C: Counters, const AVX: bool>(
         &self,
         ray: &Ray<S>,
         stats: &mut C,
@@ -136,6 +136,52 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
                             // over the 28 pairs instead mispredicts on incoherent rays. (Written
                             // out here and above: one closure for both sites compiled to an
                             // index, without the jumps.)
+                            if COHERENT {
+                                // A jump over the 28 pairs, both children loaded from known
+                                // slots: predicted well when successive rays hit the same
+                                // pairs, mispredicted on incoherent rays.
+                                let pair = |i: usize, j: usize| {
+                                    let (a, b) = (slot(i as u32), slot(j as u32));
+                                    if b.2 < a.2 {
+                                        (b, a)
+                                    } else {
+                                        (a, b)
+                                    }
+                                };
+                                let (near, far) = match hit {
+                                    0b00000011 => pair(0, 1),
+                                    0b00000101 => pair(0, 2),
+                                    0b00001001 => pair(0, 3),
+                                    0b00010001 => pair(0, 4),
+                                    0b00100001 => pair(0, 5),
+                                    0b01000001 => pair(0, 6),
+                                    0b10000001 => pair(0, 7),
+                                    0b00000110 => pair(1, 2),
+                                    0b00001010 => pair(1, 3),
+                                    0b00010010 => pair(1, 4),
+                                    0b00100010 => pair(1, 5),
+                                    0b01000010 => pair(1, 6),
+                                    0b10000010 => pair(1, 7),
+                                    0b00001100 => pair(2, 3),
+                                    0b00010100 => pair(2, 4),
+                                    0b00100100 => pair(2, 5),
+                                    0b01000100 => pair(2, 6),
+                                    0b10000100 => pair(2, 7),
+                                    0b00011000 => pair(3, 4),
+                                    0b00101000 => pair(3, 5),
+                                    0b01001000 => pair(3, 6),
+                                    0b10001000 => pair(3, 7),
+                                    0b00110000 => pair(4, 5),
+                                    0b01010000 => pair(4, 6),
+                                    0b10010000 => pair(4, 7),
+                                    0b01100000 => pair(5, 6),
+                                    0b10100000 => pair(5, 7),
+                                    _ => pair(6, 7),
+                                };
+                                let _ = stack.push(far);
+                                (child, count) = (near.0, near.1);
+                                continue 'walk;
+                            }
                             let (i, j) = (hit.trailing_zeros(), others.trailing_zeros());
                             let (near, far) = if t[j as usize % 8] < t[i as usize % 8] {
                                 (j, i)
@@ -157,6 +203,39 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
                         }
                         // Three or more: insertion into nearest-first order (the first of
                         // equals first), then the farthest pushed first.
+                        if COHERENT {
+                            // Slot numbers sorted, the farther children pushed by index and
+                            // the nearest reached by branch, as for one and two hits.
+                            let mut e: [(u32, S); 8] = [(0, t_min); 8];
+                            let mut n = 0usize;
+                            let mut rest = hit;
+                            while rest != 0 {
+                                let i = rest.trailing_zeros();
+                                let x = (i, t[i as usize % 8]);
+                                rest &= rest - 1;
+                                let mut m = n;
+                                while m > 0 && x.1 < e[(m - 1) % 8].1 {
+                                    e[m % 8] = e[(m - 1) % 8];
+                                    m -= 1;
+                                }
+                                e[m % 8] = x;
+                                n += 1;
+                            }
+                            for &(far, _) in e.get(1..n).unwrap_or_default().iter().rev() {
+                                let _ = stack.push(slot(far));
+                            }
+                            (child, count) = match e[0].0 {
+                                0 => (node.child[0], node.count[0]),
+                                1 => (node.child[1], node.count[1]),
+                                2 => (node.child[2], node.count[2]),
+                                3 => (node.child[3], node.count[3]),
+                                4 => (node.child[4], node.count[4]),
+                                5 => (node.child[5], node.count[5]),
+                                6 => (node.child[6], node.count[6]),
+                                _ => (node.child[7], node.count[7]),
+                            };
+                            continue 'walk;
+                        }
                         let mut e: [Entry<S>; 8] = [(0, 0, t_min); 8];
                         let mut n = 0usize;
                         let mut rest = hit;
