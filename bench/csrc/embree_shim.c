@@ -86,12 +86,21 @@ RTCScene rkb_embree_build(rkb_embree *e, const float *vertices, size_t vertex_co
 
 void rkb_embree_scene_free(RTCScene scene) { rtcReleaseScene(scene); }
 
+/* The intersection context for a ray set: Embree's default (incoherent), or its coherent
+ * flag when `coherent` is not zero. */
+static void rkb_context(struct RTCIntersectContext *context, int coherent) {
+    rtcInitIntersectContext(context);
+    if (coherent) {
+        context->flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    }
+}
+
 /* Closest hit of each of `count` records (8 floats each: origin, direction, tmin, tmax):
  * t and primitive id per record (+inf and 0xFFFFFFFF on a miss). */
-void rkb_embree_closest(RTCScene scene, const float *records, size_t count, float *t_out,
-                        uint32_t *prim_out) {
+void rkb_embree_closest(RTCScene scene, const float *records, size_t count, int coherent,
+                        float *t_out, uint32_t *prim_out) {
     struct RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
+    rkb_context(&context, coherent);
     for (size_t k = 0; k < count; k++) {
         const float *r = records + 8 * k;
         struct RTCRayHit rh;
@@ -122,9 +131,9 @@ void rkb_embree_closest(RTCScene scene, const float *records, size_t count, floa
 }
 
 /* Any hit of each of `count` records: how many are occluded. */
-size_t rkb_embree_occluded(RTCScene scene, const float *records, size_t count) {
+size_t rkb_embree_occluded(RTCScene scene, const float *records, size_t count, int coherent) {
     struct RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
+    rkb_context(&context, coherent);
     size_t occluded = 0;
     for (size_t i = 0; i < count; i++) {
         const float *r = records + 8 * i;

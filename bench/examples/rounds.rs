@@ -57,7 +57,7 @@ fn simd_ab(scene: &BenchScene, set: &RaySet, rounds: usize) -> Result<(), Error>
         );
         return Ok(());
     }
-    let structures = rounds::STRUCTURES.len();
+    let structures = rounds::CONTENDERS.len();
     let (mut per_ray, mut prebuilt) = (vec![Vec::new(); structures], vec![Vec::new(); structures]);
     for _ in 0..rounds.max(1) {
         let once = |simd| {
@@ -71,13 +71,13 @@ fn simd_ab(scene: &BenchScene, set: &RaySet, rounds: usize) -> Result<(), Error>
             prebuilt[i].push(ratio(&a.prebuilt_mrays, &b.prebuilt_mrays));
         }
     }
-    for (i, kind) in rounds::STRUCTURES.iter().enumerate() {
+    for (i, name) in rounds::CONTENDERS.iter().enumerate() {
         let listed: Vec<String> = per_ray[i].iter().map(|r| format!("{r:.3}")).collect();
         println!(
             "{:8} {:10} {} avx2 ÷ baseline per ray {:.3} (rounds {}), pre-built {:.3}",
             scene.name,
             set.kind.name(),
-            kind.name(),
+            name,
             median(&per_ray[i]),
             listed.join(" "),
             median(&prebuilt[i])
@@ -112,7 +112,7 @@ fn main() -> Result<(), Error> {
         return Ok(());
     }
     println!(
-        "scene    rays       structure  setup ns  ours  pre-built  Embree  ours/Embree per round: median (min-max)"
+        "scene    rays       structure          setup ns  ours  pre-built  Embree  ours/Embree per round: median (min-max)"
     );
     for scene in &scenes {
         for set in &scene.ray_sets {
@@ -138,7 +138,7 @@ fn main() -> Result<(), Error> {
                     " "
                 };
                 println!(
-                    "{:8} {:10} {:5}{mark}    {setup:8.1}  {per_ray:4.2}  {prebuilt:9.2}  {versus}",
+                    "{:8} {:10} {:13}{mark}    {setup:8.1}  {per_ray:4.2}  {prebuilt:9.2}  {versus}",
                     scene.name,
                     set.kind.name(),
                     ours.structure,

@@ -19,6 +19,7 @@
 //! The only `unsafe` code of the benchmark is here: the foreign calls, and the `vzeroupper`.
 #![allow(unsafe_code)]
 
+use crate::workload::RayKind;
 use host::obj::Mesh;
 use host::rayfile::{HitRecord, RayRecord};
 use host::trace::millis;
@@ -53,10 +54,16 @@ mod ffi {
             scene: *mut c_void,
             records: *const f32,
             count: usize,
+            coherent: i32,
             t_out: *mut f32,
             prim_out: *mut u32,
         );
-        pub fn rkb_embree_occluded(scene: *mut c_void, records: *const f32, count: usize) -> usize;
+        pub fn rkb_embree_occluded(
+            scene: *mut c_void,
+            records: *const f32,
+            count: usize,
+            coherent: i32,
+        ) -> usize;
     }
 }
 
@@ -199,9 +206,10 @@ impl<'d> Scene<'d> {
     }
 
     /// Closest hit of every record (one `rtcIntersect1` each, timed) and the loop's wall
-    /// time, ms. `records` is [`flat_records`] of the ray set.
+    /// time, ms. `records` is [`flat_records`] of a ray set of `kind`: primary rays are traced
+    /// with Embree's coherent flag ([`coherent_flag`]).
     #[must_use]
-    pub fn closest(&self, records: &[f32]) -> (Vec<HitRecord>, f64) {
+    pub fn closest(&self, records: &[f32], kind: RayKind) -> (Vec<HitRecord>, f64) {
         let count = records.len() / 8;
         let mut t = vec![f32::INFINITY; count];
         let mut prim = vec![u32::MAX; count];
@@ -213,6 +221,7 @@ impl<'d> Scene<'d> {
                 self.raw.as_ptr(),
                 records.as_ptr(),
                 count,
+                coherent_flag(kind),
                 t.as_mut_ptr(),
                 prim.as_mut_ptr(),
             );
@@ -234,13 +243,18 @@ impl<'d> Scene<'d> {
     }
 
     /// Any hit of every record (one `rtcOccluded1` each, timed): how many are occluded, and
-    /// the loop's wall time, ms.
+    /// the loop's wall time, ms. Flags as in [`Scene::closest`].
     #[must_use]
-    pub fn occluded(&self, records: &[f32]) -> (usize, f64) {
+    pub fn occluded(&self, records: &[f32], kind: RayKind) -> (usize, f64) {
         let start = Instant::now();
         // SAFETY: as in `closest`.
         let n = unsafe {
-            ffi::rkb_embree_occluded(self.raw.as_ptr(), records.as_ptr(), records.len() / 8)
+            ffi::rkb_embree_occluded(
+                self.raw.as_ptr(),
+                records.as_ptr(),
+                records.len() / 8,
+                coherent_flag(kind),
+            )
         };
         let ms = millis(start);
         clear_upper_vector_state();
@@ -253,6 +267,13 @@ impl Drop for Scene<'_> {
         // SAFETY: the scene is live and released once.
         unsafe { ffi::rkb_embree_scene_free(self.raw.as_ptr()) }
     }
+}
+
+/// The shim's `coherent` argument for a ray set: Embree's `RTC_INTERSECT_CONTEXT_FLAG_COHERENT`
+/// for primary rays (as ours are traced through `raykernel::Coherent` in the contender that
+/// names that walk), its default incoherent flag otherwise.
+fn coherent_flag(kind: RayKind) -> i32 {
+    i32::from(kind == RayKind::Primary)
 }
 
 /// The records as Embree's shim reads them: 8 floats each (origin, direction, tmin, tmax),

@@ -14,7 +14,7 @@ use host::trace::{
 };
 use raykernel::bvh::{BuildOptions, BuilderKind};
 use raykernel::{
-    Accel, AccelKind, AccelVisitor, Primitive, Scalar, TraversalStats, Triangle, I16F16,
+    Accel, AccelKind, AccelVisitor, Coherent, Primitive, Scalar, TraversalStats, Triangle, I16F16,
 };
 use std::hint::black_box;
 use std::path::Path;
@@ -39,10 +39,23 @@ pub struct OurConfig {
     pub mode: Mode,
     /// Möller–Trumbore instead of the watertight test (`f32` only).
     pub mt: bool,
+    /// Queried through [`Coherent`]: the walk for coherent rays (the 8-wide BVH's).
+    pub coherent: bool,
+}
+
+impl OurConfig {
+    /// The contender's name: `raykernel` and the structure, `coherent` for the walk for
+    /// coherent rays.
+    #[must_use]
+    pub fn contender(&self) -> String {
+        let walk = if self.coherent { " coherent" } else { "" };
+        format!("raykernel {}{walk}", self.accel.accel.name())
+    }
 }
 
 /// Every configuration measured: for each non-brute-force accelerator and each builder it
-/// takes, `f32` and fixed point; plus `f32` Möller–Trumbore on the default BVH builder.
+/// takes, `f32` and fixed point; plus `f32` Möller–Trumbore on the default BVH builder, and
+/// the 8-wide BVH from the default builder queried by its walk for coherent rays, both modes.
 #[must_use]
 pub fn configs() -> Vec<OurConfig> {
     let mut out = Vec::new();
@@ -65,18 +78,26 @@ pub fn configs() -> Vec<OurConfig> {
                 }),
                 leaf_order: accel.permutes_into_leaf_order(),
             };
-            for mode in Mode::ALL {
-                out.push(OurConfig {
-                    accel,
-                    mode,
-                    mt: false,
-                });
+            let has_coherent_walk = accel.accel == AccelKind::Bvh8(BuildOptions::default());
+            for coherent in [false, true] {
+                if coherent && !has_coherent_walk {
+                    continue;
+                }
+                for mode in Mode::ALL {
+                    out.push(OurConfig {
+                        accel,
+                        mode,
+                        mt: false,
+                        coherent,
+                    });
+                }
             }
             if accel.accel == AccelKind::Bvh(BuildOptions::default()) {
                 out.push(OurConfig {
                     accel,
                     mode: Mode::F32,
                     mt: true,
+                    coherent: false,
                 });
             }
         }
@@ -85,7 +106,7 @@ pub fn configs() -> Vec<OurConfig> {
 }
 
 /// Scenes above this many triangles (the city) run the headline configurations only: the
-/// 4-wide and 8-wide BVHs from the SAH build in both modes. The full matrix there would take most of a
+/// 4-wide and 8-wide BVHs from the SAH build in both modes (the 8-wide by both walks). The full matrix there would take most of a
 /// run's time for structures that lose on every smaller scene already.
 pub const LARGE_SCENE_TRIANGLES: usize = 500_000;
 
@@ -132,10 +153,10 @@ pub fn run(scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Result<Vec<Tra
     let mut rows = Vec::new();
     for config in configs_for(scene.mesh.triangle_count()) {
         let measured = match (config.mode, config.mt, &tris_fixed, &prepared_fixed) {
-            (Mode::F32, false, _, _) => measure(&tris32, &prepared32, &rays, &config.accel)?,
-            (Mode::F32, true, _, _) => measure(&mt, &prepared32, &rays, &config.accel)?,
+            (Mode::F32, false, _, _) => measure(&tris32, &prepared32, &rays, &config)?,
+            (Mode::F32, true, _, _) => measure(&mt, &prepared32, &rays, &config)?,
             (Mode::Fixed, _, Some(tris), Some(prepared)) => {
-                measure(tris, prepared, &rays, &config.accel)?
+                measure(tris, prepared, &rays, &config)?
             }
             (Mode::Fixed, _, _, _) => continue,
         };
@@ -151,7 +172,7 @@ pub fn run(scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Result<Vec<Tra
             ray_count: n,
             triangles: tris32.len(),
             ours: true,
-            contender: format!("raykernel {}", config.accel.accel.name()),
+            contender: config.contender(),
             builder: config
                 .accel
                 .accel
@@ -211,7 +232,7 @@ pub fn warm_up(scene: &BenchScene, set: &RaySet) -> Result<(), Error> {
         opts: RunOptions { runs: 1 },
         scene: &scene.path,
     };
-    measure(&tris32, &prepared, &rays, &config.accel).map(|_| ())
+    measure(&tris32, &prepared, &rays, &config).map(|_| ())
 }
 
 /// Million rays per second.
@@ -250,15 +271,15 @@ pub(crate) struct Measured {
 
 /// `runs` full runs of build + closest-hit trace (per ray, then pre-built); the last run also
 /// times any hit once each way and counts nodes and primitives in one more closest-hit pass
-/// (untimed).
+/// (untimed). `config`'s number mode and triangle test are those of `S` and `P`.
 pub(crate) fn measure<S: Scalar, P: Primitive<S> + Copy>(
     prims: &[P],
     prepared: &PreparedRays<S>,
     rays: &Records<'_>,
-    config: &AccelConfig,
+    config: &OurConfig,
 ) -> Result<Measured, Error> {
     let runs = rays.opts.runs.max(1);
-    let mut arena = NodeArena::<S>::for_accel(config.accel, prims);
+    let mut arena = NodeArena::<S>::for_accel(config.accel.accel, prims);
     let (mut builds, mut closest, mut per_ray) = (Vec::new(), Vec::new(), Vec::new());
     let mut last = None;
     for run in 0..runs {
@@ -268,8 +289,9 @@ pub(crate) fn measure<S: Scalar, P: Primitive<S> + Copy>(
             prepared,
             records: rays.traced,
             extras,
+            coherent: config.coherent,
         };
-        let (figures, out) = build_and_visit(prims, &mut arena, rays.scene, config, pass)?;
+        let (figures, out) = build_and_visit(prims, &mut arena, rays.scene, &config.accel, pass)?;
         builds.push(figures.build_ms);
         closest.push(out.closest_ms);
         per_ray.push(out.per_ray_ms);
@@ -292,11 +314,13 @@ pub(crate) fn measure<S: Scalar, P: Primitive<S> + Copy>(
 }
 
 /// One pass over a built accelerator: closest hit per ray and pre-built (timed); with
-/// `extras`, also any hit both ways (timed once) and a counted closest-hit pass.
+/// `extras`, also any hit both ways (timed once) and a counted closest-hit pass. With
+/// `coherent`, every query goes through [`Coherent`].
 struct Pass<'p, S: Scalar> {
     prepared: &'p PreparedRays<S>,
     records: &'p [RayRecord],
     extras: bool,
+    coherent: bool,
 }
 
 struct PassOut {
@@ -313,6 +337,16 @@ impl<S: Scalar> AccelVisitor<S> for Pass<'_, S> {
     type Output = PassOut;
 
     fn visit<A: Accel<S>>(self, accel: &A) -> PassOut {
+        if self.coherent {
+            self.run(&Coherent(accel))
+        } else {
+            self.run(accel)
+        }
+    }
+}
+
+impl<S: Scalar> Pass<'_, S> {
+    fn run<A: Accel<S>>(self, accel: &A) -> PassOut {
         let (_, per_ray_ms) = trace_closest_per_ray(accel, self.records);
         let (hits, closest_ms) = trace_closest(accel, self.prepared);
         let mut out = PassOut {

@@ -124,19 +124,11 @@ pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Op
         #[cfg(not(feature = "tinybvh"))]
         Peer::TinybvhBvh2 => return None,
         #[cfg(feature = "embree")]
-        Peer::EmbreeHigh => embree_peer::run(
-            crate::embree::Quality::High,
-            &scene.mesh,
-            &set.records,
-            opts,
-        )?,
+        Peer::EmbreeHigh => embree_peer::run(crate::embree::Quality::High, &scene.mesh, set, opts)?,
         #[cfg(feature = "embree")]
-        Peer::EmbreeMedium => embree_peer::run(
-            crate::embree::Quality::Medium,
-            &scene.mesh,
-            &set.records,
-            opts,
-        )?,
+        Peer::EmbreeMedium => {
+            embree_peer::run(crate::embree::Quality::Medium, &scene.mesh, set, opts)?
+        }
         #[cfg(not(feature = "embree"))]
         Peer::EmbreeHigh | Peer::EmbreeMedium => return None,
     };
@@ -192,33 +184,33 @@ mod embree_peer {
     use super::{empty_measured, PeerMeasured};
     use crate::embree::{flat_records, Device, Geometry, Quality, Scene};
     use crate::ours::RunOptions;
+    use crate::workload::RaySet;
     use host::obj::Mesh;
-    use host::rayfile::RayRecord;
     use host::trace::median;
 
-    /// `runs` builds at `quality`, each followed by a closest-hit pass over the records; any
-    /// hit once after the last. `None` if Embree cannot make a
+    /// `runs` builds at `quality`, each followed by a closest-hit pass over the set's records
+    /// (flagged coherent for primary rays, see [`Scene::closest`]); any hit once after the last. `None` if Embree cannot make a
     /// device or refuses the scene.
     pub(super) fn run(
         quality: Quality,
         mesh: &Mesh,
-        records: &[RayRecord],
+        set: &RaySet,
         opts: RunOptions,
     ) -> Option<PeerMeasured> {
         let device = Device::new()?;
         let geometry = Geometry::of(mesh);
-        let flat = flat_records(records);
+        let flat = flat_records(&set.records);
         let (mut builds, mut closest) = (Vec::new(), Vec::new());
         let mut m = empty_measured();
         for run in 0..opts.runs.max(1) {
             let (scene, built) = Scene::build(&device, &geometry, quality)?;
             builds.push(built.build_ms);
-            let (hits, ms) = scene.closest(&flat);
+            let (hits, ms) = scene.closest(&flat, set.kind);
             closest.push(ms);
             m.hits = hits;
             m.bytes = built.bytes;
             if run + 1 == opts.runs.max(1) {
-                let (occluded, ms) = scene.occluded(&flat);
+                let (occluded, ms) = scene.occluded(&flat, set.kind);
                 m.any_hits = occluded;
                 m.any_ms = ms;
             }

@@ -342,9 +342,13 @@ fn file_name(path: &Path) -> String {
 }
 
 /// The reference row of a ray set: ours, `f32`, watertight, default builder.
-/// The headline structures: the wide BVHs collapsed from the SAH BVH (as named in
-/// [`TraceRow::contender`]).
-const HEADLINE_STRUCTURES: [&str; 2] = ["raykernel bvh4", "raykernel bvh8"];
+/// The headline structures: the wide BVHs collapsed from the SAH BVH, the 8-wide by both of
+/// its walks (as named in [`TraceRow::contender`]).
+const HEADLINE_STRUCTURES: [&str; 3] = [
+    "raykernel bvh4",
+    "raykernel bvh8",
+    "raykernel bvh8 coherent",
+];
 
 /// A contender of ours without the `raykernel ` prefix: the structure's name.
 fn structure(row: &TraceRow) -> &str {
@@ -501,9 +505,13 @@ fn headline_section(s: &mut String, r: &BenchResults) {
          `rtcIntersect1` takes the raw record; the other peers take rays converted ahead, so \
          their conversion time is added to their trace time. `pre-built` is raykernel tracing \
          rays constructed ahead (traversal alone). Ours is raykernel `f32`, watertight, with \
-         the faster per ray on the ray set (`structure`) of the 4-wide and the 8-wide BVH, \
+         the fastest per ray on the ray set (`structure`) of the 4-wide and the 8-wide BVH, \
          both collapsed from the SAH BVH with the triangles permuted into leaf order \
-         (`build_in_leaf_order`, in place); ratios are ours per ray ÷ peer: above \
+         (`build_in_leaf_order`, in place), the 8-wide one queried by its default walk and by \
+         its walk for coherent rays (`bvh8 coherent`: through `raykernel::Coherent`, the \
+         caller's hint that successive rays are alike, as Embree's \
+         `RTC_INTERSECT_CONTEXT_FLAG_COHERENT` is; Embree is given that flag on primary rays, \
+         its default incoherent one otherwise); ratios are ours per ray ÷ peer: above \
          1 means ours is faster. `fixed ÷ f32` is fixed point per ray, ray construction \
          included, against `f32`: the faster wide BVH in fixed point (named beside its figure), \
          which need not be the one of `f32`.\n"
@@ -663,7 +671,8 @@ fn rounds_section(s: &mut String, r: &BenchResults) {
         s,
         "### Interleaved rounds\n\n\
          Each ray set traced {} times in alternation: raykernel `f32` (the 4-wide and the \
-         8-wide BVH, SAH, leaf order) per ray, Embree 3 HIGH, raykernel on pre-built rays, \
+         8-wide BVH, SAH, leaf order; the 8-wide by both walks) per ray, Embree 3 HIGH \
+         (coherent flag on primary rays), raykernel on pre-built rays, \
          tinybvh 1.6's BVH2 on pre-built rays; each structure built once. A slow spell of the \
          machine then slows every contender of a round, so the per-round ratio is the robust \
          comparison: ours per ray ÷ Embree (both pay their ray setup), ours pre-built ÷ tinybvh \
@@ -1408,7 +1417,8 @@ fn notes_section(s: &mut String) {
          - Trace: wall time of tracing every ray and storing `{{t, prim}}`. Per ray: ours \
          constructs `Ray::from_f32` from each record inside the loop; Embree gets one \
          `rtcIntersect1` call per record (origin, direction, tnear = tmin, tfar = tmax as \
-         given) from a C loop in the benchmark's shim; the other peers' conversion to their ray \
+         given) from a C loop in the benchmark's shim, its context flagged coherent on primary \
+         rays; the other peers' conversion to their ray \
          type is timed apart (`setup`) and added. Pre-built: tracing rays converted ahead.\n\
          - Peers' triangle tests: Embree its own; obvhs its own two-sided Möller–Trumbore; \
          bvh's `intersects_triangle` culls back faces, so its rows use this benchmark's \
@@ -1422,7 +1432,8 @@ fn notes_section(s: &mut String) {
          copies, counted in the blocks it reserves); obvhs and tinybvh, nodes and primitive \
          indices; bvh, nodes only. The triangles themselves are not counted.\n\
          - The city (`make_tiled.py`, 1.2M triangles) runs the headline configurations of ours \
-         only (the 4-wide and the 8-wide BVH from the SAH BVH, both modes), with every peer.\n\
+         only (the 4-wide and the 8-wide BVH from the SAH BVH, the 8-wide by both walks, both \
+         modes), with every peer.\n\
          - `data.json`'s `figures` holds one row per scene, ray set, contender and figure; \
          `bench/scripts/ratios.py data.json` recomputes the headline and round ratios from \
          them.\n\

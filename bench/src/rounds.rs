@@ -1,9 +1,9 @@
 //! Interleaved rounds: the headline contenders (the 4-wide and the 8-wide BVH collapsed from
-//! the SAH BVH, `f32`, leaf order) and the peers they are compared with trace one ray set in
-//! alternation, round after round: ours per ray (each ray constructed from its record in the
-//! timed loop), Embree HIGH (`rtcIntersect1` on the raw records, with the `embree` feature),
-//! ours on pre-built rays, tinybvh's BVH2 on pre-built rays (with the `tinybvh` feature); then
-//! again. Each structure is built once; only tracing is timed. The per-round ratios pair like
+//! the SAH BVH, `f32`, leaf order, the 8-wide by both of its walks) and the peers they are
+//! compared with trace one ray set in alternation, round after round: ours per ray (each ray
+//! constructed from its record in the timed loop), Embree HIGH (`rtcIntersect1` on the raw
+//! records, flagged coherent on primary rays, with the `embree` feature), ours on pre-built
+//! rays, tinybvh's BVH2 on pre-built rays (with the `tinybvh` feature); then again. Each structure is built once; only tracing is timed. The per-round ratios pair like
 //! with like: ours per ray ÷ Embree (both pay their ray setup), ours pre-built ÷ tinybvh
 //! (neither does).
 //!
@@ -23,7 +23,7 @@ use host::trace::{
     NodeArena, PreparedRays,
 };
 use raykernel::bvh::BuildOptions;
-use raykernel::{Accel, AccelKind, AccelVisitor, Triangle};
+use raykernel::{Accel, AccelKind, AccelVisitor, Coherent, Triangle};
 use serde::Serialize;
 
 /// The structures of the rounds, in this order: the wide BVHs from the SAH build.
@@ -32,10 +32,14 @@ pub const STRUCTURES: [AccelKind; 2] = [
     AccelKind::Bvh8(BuildOptions::DEFAULT),
 ];
 
+/// Ours in the rounds, in this order: each of [`STRUCTURES`], then the 8-wide BVH queried
+/// through [`Coherent`] (its walk for coherent rays), as the report names them.
+pub const CONTENDERS: [&str; 3] = ["bvh4", "bvh8", "bvh8 coherent"];
+
 /// One of ours in the rounds: Mrays/s in each round.
 #[derive(Clone, Debug, Serialize)]
 pub struct OursRounds {
-    /// The structure's name (`bvh4`, `bvh8`).
+    /// The contender's name (one of [`CONTENDERS`]).
     pub structure: &'static str,
     /// Each ray constructed in the loop (closest hit).
     pub per_ray_mrays: Vec<f64>,
@@ -53,7 +57,7 @@ pub struct RoundsRow {
     pub rays: RayKind,
     /// Rays traced per round.
     pub ray_count: usize,
-    /// Ours, one entry per structure of [`STRUCTURES`].
+    /// Ours, one entry per contender of [`CONTENDERS`].
     pub ours: Vec<OursRounds>,
     /// Embree 3 HIGH, `rtcIntersect1` on the raw records.
     pub embree_mrays: Vec<f64>,
@@ -168,6 +172,7 @@ pub fn run(
     let mut second_arena = NodeArena::<f32>::for_accel(second.accel, &tris);
     let rounds_of = Alternate {
         scene,
+        set,
         records: &set.records,
         prepared: &prepared,
         rounds: rounds.max(1),
@@ -182,12 +187,12 @@ pub fn run(
     };
     let (_, figures) = build_and_visit(&tris, &mut arena, &scene.path, &first, builds_second)?;
     let figures = figures?;
-    let ours = STRUCTURES
+    let ours = CONTENDERS
         .iter()
         .zip(figures.per_ray)
         .zip(figures.prebuilt)
-        .map(|((kind, per_ray_mrays), prebuilt_mrays)| OursRounds {
-            structure: kind.name(),
+        .map(|((&structure, per_ray_mrays), prebuilt_mrays)| OursRounds {
+            structure,
             per_ray_mrays,
             prebuilt_mrays,
         })
@@ -242,17 +247,18 @@ impl<A: Accel<f32>> AccelVisitor<f32> for Both<'_, '_, A> {
 /// The rounds over the two built structures.
 struct Alternate<'p> {
     scene: &'p BenchScene,
+    set: &'p RaySet,
     records: &'p [RayRecord],
     prepared: &'p PreparedRays<f32>,
     rounds: usize,
     with_peers: bool,
 }
 
-/// Each contender's figures, round by round; ours per structure of [`STRUCTURES`].
+/// Each contender's figures, round by round; ours per contender of [`CONTENDERS`].
 #[derive(Default)]
 struct Figures {
-    per_ray: [Vec<f64>; 2],
-    prebuilt: [Vec<f64>; 2],
+    per_ray: [Vec<f64>; 3],
+    prebuilt: [Vec<f64>; 3],
     embree: Vec<f64>,
     tinybvh: Vec<f64>,
 }
@@ -261,18 +267,21 @@ impl Alternate<'_> {
     fn run<A: Accel<f32>, B: Accel<f32>>(self, first: &A, second: &B) -> Figures {
         let n = self.prepared.rays.len();
         let mut figures = Figures::default();
-        let inputs = EmbreeInputs::new(self.scene, self.records, self.with_peers);
+        let inputs = EmbreeInputs::new(self.scene, self.set, self.with_peers);
         let embree = inputs.build();
+        let coherent = Coherent(second);
         let round = |figures: &mut Figures| {
-            let [per_ray_a, per_ray_b] = &mut figures.per_ray;
+            let [per_ray_a, per_ray_b, per_ray_c] = &mut figures.per_ray;
             per_ray_a.push(mrays(n, trace_closest_per_ray(first, self.records).1));
             per_ray_b.push(mrays(n, trace_closest_per_ray(second, self.records).1));
+            per_ray_c.push(mrays(n, trace_closest_per_ray(&coherent, self.records).1));
             if let Some(e) = &embree {
                 figures.embree.push(e.trace());
             }
-            let [prebuilt_a, prebuilt_b] = &mut figures.prebuilt;
+            let [prebuilt_a, prebuilt_b, prebuilt_c] = &mut figures.prebuilt;
             prebuilt_a.push(mrays(n, trace_closest(first, self.prepared).1));
             prebuilt_b.push(mrays(n, trace_closest(second, self.prepared).1));
+            prebuilt_c.push(mrays(n, trace_closest(&coherent, self.prepared).1));
         };
         let tinybvh = self.with_peers.then(|| {
             let tris: Vec<[[f32; 3]; 3]> = (0..self.scene.mesh.triangle_count())
@@ -304,20 +313,22 @@ struct EmbreeInputs {
     device: Option<crate::embree::Device>,
     geometry: crate::embree::Geometry,
     flat: Vec<f32>,
+    kind: RayKind,
 }
 
 #[cfg(feature = "embree")]
 impl EmbreeInputs {
-    fn new(scene: &BenchScene, records: &[RayRecord], wanted: bool) -> Self {
+    fn new(scene: &BenchScene, set: &RaySet, wanted: bool) -> Self {
         use crate::embree::{flat_records, Device, Geometry};
         Self {
             device: if wanted { Device::new() } else { None },
             geometry: Geometry::of(&scene.mesh),
             flat: if wanted {
-                flat_records(records)
+                flat_records(&set.records)
             } else {
                 Vec::new()
             },
+            kind: set.kind,
         }
     }
 
@@ -328,6 +339,7 @@ impl EmbreeInputs {
         Some(EmbreeTracer {
             scene,
             flat: &self.flat,
+            kind: self.kind,
         })
     }
 }
@@ -336,12 +348,13 @@ impl EmbreeInputs {
 struct EmbreeTracer<'a> {
     scene: crate::embree::Scene<'a>,
     flat: &'a [f32],
+    kind: RayKind,
 }
 
 #[cfg(feature = "embree")]
 impl EmbreeTracer<'_> {
     fn trace(&self) -> f64 {
-        let (hits, ms) = self.scene.closest(self.flat);
+        let (hits, ms) = self.scene.closest(self.flat, self.kind);
         mrays(hits.len(), ms)
     }
 }
@@ -351,7 +364,7 @@ struct EmbreeInputs;
 
 #[cfg(not(feature = "embree"))]
 impl EmbreeInputs {
-    fn new(_: &BenchScene, _: &[RayRecord], _: bool) -> Self {
+    fn new(_: &BenchScene, _: &RaySet, _: bool) -> Self {
         Self
     }
 
