@@ -132,10 +132,6 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
                         }
                         if others & (others - 1) == 0 {
                             // Two: visit the nearer (the first on a tie), push the other.
-                            // The nearer reached by branch again (a jump over its slot); a jump
-                            // over the 28 pairs instead mispredicts on incoherent rays. (Written
-                            // out here and above: one closure for both sites compiled to an
-                            // index, without the jumps.)
                             if COHERENT {
                                 // A jump over the 28 pairs, both children loaded from known
                                 // slots: predicted well when successive rays hit the same
@@ -182,6 +178,10 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
                                 (child, count) = (near.0, near.1);
                                 continue 'walk;
                             }
+                            // The nearer reached by branch again (a jump over its slot), which
+                            // incoherent rays mispredict less often than a jump over the pairs.
+                            // (The slot `match`es are written out here, above and below: one
+                            // closure for the sites compiled to an index, without the jumps.)
                             let (i, j) = (hit.trailing_zeros(), others.trailing_zeros());
                             let (near, far) = if t[j as usize % 8] < t[i as usize % 8] {
                                 (j, i)
@@ -205,7 +205,9 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
                         // equals first), then the farthest pushed first.
                         if COHERENT {
                             // Slot numbers sorted, the farther children pushed by index and
-                            // the nearest reached by branch, as for one and two hits.
+                            // the nearest reached by branch, as for one and two hits. (Both
+                            // sorts written out: one generic insertion for both, or slot
+                            // numbers sorted in the default walk too, measured slower.)
                             let mut e: [(u32, S); 8] = [(0, t_min); 8];
                             let mut n = 0usize;
                             let mut rest = hit;
