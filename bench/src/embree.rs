@@ -207,7 +207,7 @@ impl<'d> Scene<'d> {
 
     /// Closest hit of every record (one `rtcIntersect1` each, timed) and the loop's wall
     /// time, ms. `records` is [`flat_records`] of a ray set of `kind`: primary rays are traced
-    /// with Embree's coherent flag ([`coherent_flag`]).
+    /// with Embree's coherent flag (`coherent_flag`).
     #[must_use]
     pub fn closest(&self, records: &[f32], kind: RayKind) -> (Vec<HitRecord>, f64) {
         let count = records.len() / 8;

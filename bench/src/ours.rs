@@ -106,8 +106,9 @@ pub fn configs() -> Vec<OurConfig> {
 }
 
 /// Scenes above this many triangles (the city) run the headline configurations only: the
-/// 4-wide and 8-wide BVHs from the SAH build in both modes (the 8-wide by both walks). The full matrix there would take most of a
-/// run's time for structures that lose on every smaller scene already.
+/// 4-wide and 8-wide BVHs from the SAH build in both modes (the 8-wide by both walks). The
+/// full matrix there would take most of a run's time for structures that lose on every
+/// smaller scene already.
 pub const LARGE_SCENE_TRIANGLES: usize = 500_000;
 
 /// The configurations measured on a scene of `triangles`: every one of [`configs`], or the

@@ -189,8 +189,8 @@ mod embree_peer {
     use host::trace::median;
 
     /// `runs` builds at `quality`, each followed by a closest-hit pass over the set's records
-    /// (flagged coherent for primary rays, see [`Scene::closest`]); any hit once after the last. `None` if Embree cannot make a
-    /// device or refuses the scene.
+    /// (flagged coherent for primary rays, see [`Scene::closest`]); any hit once after the
+    /// last. `None` if Embree cannot make a device or refuses the scene.
     pub(super) fn run(
         quality: Quality,
         mesh: &Mesh,

@@ -3,9 +3,9 @@
 //! compared with trace one ray set in alternation, round after round: ours per ray (each ray
 //! constructed from its record in the timed loop), Embree HIGH (`rtcIntersect1` on the raw
 //! records, flagged coherent on primary rays, with the `embree` feature), ours on pre-built
-//! rays, tinybvh's BVH2 on pre-built rays (with the `tinybvh` feature); then again. Each structure is built once; only tracing is timed. The per-round ratios pair like
-//! with like: ours per ray ÷ Embree (both pay their ray setup), ours pre-built ÷ tinybvh
-//! (neither does).
+//! rays, tinybvh's BVH2 on pre-built rays (with the `tinybvh` feature); then again. Each
+//! structure is built once; only tracing is timed. The per-round ratios pair like with like:
+//! ours per ray ÷ Embree (both pay their ray setup), ours pre-built ÷ tinybvh (neither does).
 //!
 //! Why: on a shared VM a slow spell (another tenant's memory traffic) can last seconds to
 //! minutes, long enough to cover one contender's consecutive runs and not the other's. In
@@ -59,7 +59,7 @@ pub struct RoundsRow {
     pub ray_count: usize,
     /// Ours, one entry per contender of [`CONTENDERS`].
     pub ours: Vec<OursRounds>,
-    /// Embree 3 HIGH, `rtcIntersect1` on the raw records.
+    /// Embree 3 HIGH, `rtcIntersect1` on the raw records (flagged coherent on primary rays).
     pub embree_mrays: Vec<f64>,
     /// tinybvh's BVH2 on pre-built rays.
     pub tinybvh_mrays: Vec<f64>,
@@ -173,7 +173,6 @@ pub fn run(
     let rounds_of = Alternate {
         scene,
         set,
-        records: &set.records,
         prepared: &prepared,
         rounds: rounds.max(1),
         with_peers,
@@ -248,7 +247,6 @@ impl<A: Accel<f32>> AccelVisitor<f32> for Both<'_, '_, A> {
 struct Alternate<'p> {
     scene: &'p BenchScene,
     set: &'p RaySet,
-    records: &'p [RayRecord],
     prepared: &'p PreparedRays<f32>,
     rounds: usize,
     with_peers: bool,
@@ -272,9 +270,12 @@ impl Alternate<'_> {
         let coherent = Coherent(second);
         let round = |figures: &mut Figures| {
             let [per_ray_a, per_ray_b, per_ray_c] = &mut figures.per_ray;
-            per_ray_a.push(mrays(n, trace_closest_per_ray(first, self.records).1));
-            per_ray_b.push(mrays(n, trace_closest_per_ray(second, self.records).1));
-            per_ray_c.push(mrays(n, trace_closest_per_ray(&coherent, self.records).1));
+            per_ray_a.push(mrays(n, trace_closest_per_ray(first, &self.set.records).1));
+            per_ray_b.push(mrays(n, trace_closest_per_ray(second, &self.set.records).1));
+            per_ray_c.push(mrays(
+                n,
+                trace_closest_per_ray(&coherent, &self.set.records).1,
+            ));
             if let Some(e) = &embree {
                 figures.embree.push(e.trace());
             }
@@ -287,7 +288,7 @@ impl Alternate<'_> {
             let tris: Vec<[[f32; 3]; 3]> = (0..self.scene.mesh.triangle_count())
                 .map(|i| self.scene.mesh.triangle_f32(i))
                 .collect();
-            let records: Vec<&RayRecord> = self.records.iter().collect();
+            let records: Vec<&RayRecord> = self.set.records.iter().collect();
             crate::peers::alternate_with_tinybvh(&tris, &records, self.rounds, &mut || {
                 round(&mut figures);
             })
