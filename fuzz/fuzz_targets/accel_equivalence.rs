@@ -3,7 +3,8 @@
 //! Checks, for every structure of [`kinds`] (every BVH builder and leaf size, the 4-wide and
 //! the 8-wide BVH, the grid and the kd-tree, built through `AnyAccel`; plus one leaf-order
 //! build): the structure validates, its closest hit equals brute force (`Linear`) bit for bit
-//! (t bits, prim, u bits, v bits), `occluded() == intersect().is_some()` for both, hits lie in
+//! (t bits, prim, u bits, v bits), queried directly and through `Coherent` (the 8-wide BVH's
+//! walk for coherent rays), `occluded() == intersect().is_some()` for both, hits lie in
 //! the ray's interval with barycentrics in [0, 1]; arenas one slot too small give
 //! `ArenaTooSmall`; bad vertices give `BadPrimitive` (the same one `Triangle::from_f32` names);
 //! spawned rays (`raykernel::spawn`) are valid and never panic. Nothing may panic.
@@ -15,8 +16,8 @@ use raykernel::grid::GridOptions;
 use raykernel::kdtree::{self, KdOptions};
 use raykernel::spawn::spawn_ray;
 use raykernel::{
-    Accel, AccelKind, AnyAccel, Arena, BuildError, Bvh, Hit, Linear, Node, Ray, Scalar, Triangle,
-    F32_COORD_LIMIT, I16F16,
+    Accel, AccelKind, AnyAccel, Arena, BuildError, Bvh, Coherent, Hit, Linear, Node, Ray, Scalar,
+    Triangle, F32_COORD_LIMIT, I16F16,
 };
 use raykernel_testkit::memory::OwnedMemory;
 
@@ -333,20 +334,27 @@ fn check_mode<S: Mode>(tris_f32: &[[[f32; 3]; 3]], rays_in: &[RayIn]) {
         if let Err(e) = accel.validate() {
             panic!("{} {kind}: invalid: {e:?}", S::NAME);
         }
+        // Every structure by its default walk and through `Coherent` (the 8-wide BVH's walk
+        // for coherent rays; the others' one walk).
+        let coherent = Coherent(&accel);
         for (r, w) in rays.iter().zip(&want) {
-            let got = accel.intersect(r);
-            assert_eq!(
-                bits(&got),
-                bits(w),
-                "{} {kind}: {got:?} != Linear {w:?}",
-                S::NAME
-            );
-            assert_eq!(
-                accel.occluded(r),
-                got.is_some(),
-                "{} {kind}: occluded",
-                S::NAME
-            );
+            for (walk, got, occluded) in [
+                ("", accel.intersect(r), accel.occluded(r)),
+                (" coherent", coherent.intersect(r), coherent.occluded(r)),
+            ] {
+                assert_eq!(
+                    bits(&got),
+                    bits(w),
+                    "{} {kind}{walk}: {got:?} != Linear {w:?}",
+                    S::NAME
+                );
+                assert_eq!(
+                    occluded,
+                    got.is_some(),
+                    "{} {kind}{walk}: occluded",
+                    S::NAME
+                );
+            }
         }
     }
     let mut permuted = tris.clone();

@@ -9,9 +9,11 @@
 #
 # For each scene, ray set and mode (f32, fixed):
 #   - traces the whole file with each builder (sah, median, midpoint), the 4-wide and 8-wide BVHs
-#     (SAH), the grid and the kd-tree, and checks the seven hit files are identical;
-#   - traces every STRIDE-th ray with --accel linear, each builder, the wide BVHs, the grid and
-#     the kd-tree, and checks each strided hit file equals the linear one (cmp);
+#     (SAH; the 8-wide by both walks, --coherent), the grid and the kd-tree, and checks the eight
+#     hit files are identical;
+#   - traces every STRIDE-th ray with --accel linear, each builder, the wide BVHs (the 8-wide by
+#     both walks), the grid and the kd-tree, and checks each strided hit file equals the linear
+#     one (cmp);
 # then prints the fixed-vs-f32 agreement of the SAH primary hits per scene (compare-hits --scene
 # --rays), which classifies every ray whose prim differs; any "unexplained" one (farther than the
 # quantization bound from every edge of both triangles, and not a depth tie) is a failure.
@@ -90,7 +92,9 @@ for scene in $scenes; do
             for a in $accels; do
                 trace "$tag $a" "$out/$tag.$a.hits" "$obj" "$rays" --mode "$mode" --accel "$a"
             done
-            for b in median midpoint $accels; do
+            trace "$tag bvh8-coherent" "$out/$tag.bvh8-coherent.hits" "$obj" "$rays" \
+                --mode "$mode" --accel bvh8 --coherent
+            for b in median midpoint $accels bvh8-coherent; do
                 same "$tag $b == sah (full)" "$out/$tag.$b.hits" "$out/$tag.sah.hits"
             done
             trace "$tag linear /$stride" "$out/$tag.linear.s$stride.hits" "$obj" "$rays" \
@@ -107,9 +111,14 @@ for scene in $scenes; do
                 same "$tag $a == linear (/$stride)" "$out/$tag.$a.s$stride.hits" \
                     "$out/$tag.linear.s$stride.hits"
             done
+            trace "$tag bvh8-coherent /$stride" "$out/$tag.bvh8-coherent.s$stride.hits" "$obj" \
+                "$rays" --mode "$mode" --accel bvh8 --coherent --stride "$stride"
+            same "$tag bvh8-coherent == linear (/$stride)" \
+                "$out/$tag.bvh8-coherent.s$stride.hits" "$out/$tag.linear.s$stride.hits"
             # Keep only what the agreement report below needs.
             rm -f "$out/$tag.median.hits" "$out/$tag.midpoint.hits" "$out/$tag".*.s"$stride".hits \
-                "$out/$tag.bvh4.hits" "$out/$tag.bvh8.hits" "$out/$tag.grid.hits" \
+                "$out/$tag.bvh4.hits" "$out/$tag.bvh8.hits" "$out/$tag.bvh8-coherent.hits" \
+                "$out/$tag.grid.hits" \
                 "$out/$tag.kdtree.hits"
         done
     done
