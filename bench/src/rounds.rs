@@ -32,9 +32,9 @@ pub const STRUCTURES: [AccelKind; 2] = [
     AccelKind::Bvh8(BuildOptions::DEFAULT),
 ];
 
-/// Ours in the rounds, in this order: each of [`STRUCTURES`], then the 8-wide BVH queried
-/// through [`Coherent`] (its walk for coherent rays), as the report names them.
-pub const CONTENDERS: [&str; 3] = ["bvh4", "bvh8", "bvh8 coherent"];
+/// Ours in the rounds, in this order: each of [`STRUCTURES`] by its name, then the 8-wide BVH
+/// queried through [`Coherent`] (its walk for coherent rays), as the report names them.
+pub const CONTENDERS: [&str; 3] = [STRUCTURES[0].name(), STRUCTURES[1].name(), "bvh8 coherent"];
 
 /// One of ours in the rounds: Mrays/s in each round.
 #[derive(Clone, Debug, Serialize)]

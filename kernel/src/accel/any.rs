@@ -247,16 +247,24 @@ impl<S: Scalar, P: Primitive<S>> Accel<S> for AnyAccel<'_, S, P> {
         stats: &mut C,
     ) -> Option<Nearest<S>> {
         match self {
+            Self::Linear(a) => a.nearest_coherent_counted(ray, stats),
+            Self::Bvh(a) => a.nearest_coherent_counted(ray, stats),
+            Self::Bvh4(a) => a.nearest_coherent_counted(ray, stats),
             Self::Bvh8(a) => a.nearest_coherent_counted(ray, stats),
-            _ => self.nearest_counted(ray, stats),
+            Self::Grid(a) => a.nearest_coherent_counted(ray, stats),
+            Self::KdTree(a) => a.nearest_coherent_counted(ray, stats),
         }
     }
 
     #[inline]
     fn occluded_coherent_counted<C: Counters>(&self, ray: &Ray<S>, stats: &mut C) -> bool {
         match self {
+            Self::Linear(a) => a.occluded_coherent_counted(ray, stats),
+            Self::Bvh(a) => a.occluded_coherent_counted(ray, stats),
+            Self::Bvh4(a) => a.occluded_coherent_counted(ray, stats),
             Self::Bvh8(a) => a.occluded_coherent_counted(ray, stats),
-            _ => self.occluded_counted(ray, stats),
+            Self::Grid(a) => a.occluded_coherent_counted(ray, stats),
+            Self::KdTree(a) => a.occluded_coherent_counted(ray, stats),
         }
     }
 
