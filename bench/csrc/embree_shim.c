@@ -61,11 +61,15 @@ int64_t rkb_embree_peak(const rkb_embree *e) { return e->peak; }
 
 /* Builds a scene of `tri_count` triangles over `vertices` (x, y, z floats; the buffer must
  * hold one float more than the vertices, as Embree reads 16 bytes per vertex) and `indices`
- * (three per triangle), at `quality` (RTC_BUILD_QUALITY_*). Both buffers must outlive the
- * scene. NULL if Embree reports an error. */
+ * (three per triangle), at `quality` (RTC_BUILD_QUALITY_*), in Embree's robust mode
+ * (RTC_SCENE_FLAG_ROBUST) when `robust` is not zero. Both buffers must outlive the scene.
+ * NULL if Embree reports an error. */
 RTCScene rkb_embree_build(rkb_embree *e, const float *vertices, size_t vertex_count,
-                          const uint32_t *indices, size_t tri_count, int quality) {
+                          const uint32_t *indices, size_t tri_count, int quality, int robust) {
     RTCScene scene = rtcNewScene(e->device);
+    if (robust) {
+        rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    }
     rtcSetSceneBuildQuality(scene, (enum RTCBuildQuality)quality);
     RTCGeometry geom = rtcNewGeometry(e->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     rtcSetGeometryBuildQuality(geom, (enum RTCBuildQuality)quality);

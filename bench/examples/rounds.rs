@@ -1,9 +1,9 @@
 //! The interleaved rounds alone, for quick A/B work on the headline structures: per ray set,
 //! ray construction on its own (ns per ray) and the rounds of `raykernel_bench::rounds` (ours,
-//! the 4-wide and the 8-wide BVH, per ray, Embree HIGH with the `embree` feature, ours on
-//! pre-built rays, tinybvh with the `tinybvh` feature), with the per-round ratios against
-//! Embree. Seconds per scene instead of
-//! the full benchmark's quarter hour; the full run stays the one that writes the report.
+//! the 4-wide and the 8-wide BVH, per ray, Embree HIGH in its default and its robust mode with
+//! the `embree` feature, ours on pre-built rays, tinybvh with the `tinybvh` feature), with the
+//! per-round ratios against both Embree modes. Seconds per scene instead of the full
+//! benchmark's quarter hour; the full run stays the one that writes the report.
 //! `--simd-ab` compares the traversal's two compiled copies instead (`raykernel::cpu`).
 //!
 //! ```text
@@ -112,7 +112,7 @@ fn main() -> Result<(), Error> {
         return Ok(());
     }
     println!(
-        "scene    rays       structure          setup ns  ours  pre-built  Embree  ours/Embree per round: median (min-max)"
+        "scene    rays       structure          setup ns  ours  pre-built  Embree  ours/Embree per round: median (min-max)  robust  ours/robust"
     );
     for scene in &scenes {
         for set in &scene.ray_sets {
@@ -132,13 +132,21 @@ fn main() -> Result<(), Error> {
                                 p.median_ratio()
                             )
                         });
+                let robust = row.vs_embree_robust(ours).map_or(String::new(), |p| {
+                    let (lo, hi) = p.ratio_range();
+                    format!(
+                        "  {:5.2}  {:.3} ({lo:.3}-{hi:.3})",
+                        p.peer_median,
+                        p.median_ratio()
+                    )
+                });
                 let mark = if fastest == Some(ours.structure) {
                     "*"
                 } else {
                     " "
                 };
                 println!(
-                    "{:8} {:10} {:13}{mark}    {setup:8.1}  {per_ray:4.2}  {prebuilt:9.2}  {versus}",
+                    "{:8} {:10} {:13}{mark}    {setup:8.1}  {per_ray:4.2}  {prebuilt:9.2}  {versus}{robust}",
                     scene.name,
                     set.kind.name(),
                     ours.structure,

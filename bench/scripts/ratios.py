@@ -5,7 +5,8 @@ usage: ratios.py DATA_JSON [--figure closest_mrays] [--ours "raykernel bvh4 sah 
 
 Prints, per scene and ray set, ours / each peer for the chosen figure (default: the
 per-ray closest-hit Mrays/s, the headline), then the median per-round ratios of the
-interleaved rounds (ours per ray / Embree 3 HIGH, ours pre-built / tinybvh).
+interleaved rounds (ours per ray / Embree 3 HIGH and / Embree 3 HIGH robust, ours pre-built /
+tinybvh).
 """
 import argparse
 import json
@@ -42,6 +43,7 @@ def main():
         if m:
             rounds[(r["scene"], r["rays"], r["contender"], m.group(1))][int(m.group(2))] = r["value"]
     pairs = [("closest_mrays", "Embree 3 HIGH", "closest_mrays"),
+             ("closest_mrays", "Embree 3 HIGH robust", "closest_mrays"),
              ("closest_mrays_prebuilt", "tinybvh 1.6 BVH2", "closest_mrays_prebuilt")]
     print("\nper-round ratios (median, min, max)")
     print("scene,rays,pair,median,min,max")

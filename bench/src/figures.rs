@@ -75,6 +75,11 @@ pub fn figures(r: &BenchResults) -> Vec<Figure> {
                 &x.embree_mrays,
             ),
             (
+                "Embree 3 HIGH robust".to_string(),
+                "closest_mrays",
+                &x.embree_robust_mrays,
+            ),
+            (
                 "tinybvh 1.6 BVH2".to_string(),
                 "closest_mrays_prebuilt",
                 &x.tinybvh_mrays,

@@ -1,5 +1,6 @@
 //! Peers measured in the same run, on the same triangles and rays: with the `embree` feature,
-//! Embree 3 at HIGH and MEDIUM build quality ([`crate::embree`]); `obvhs` 0.4 (BVH2 and
+//! Embree 3 at HIGH and MEDIUM build quality, and at HIGH in its robust mode
+//! ([`crate::embree`]); `obvhs` 0.4 (BVH2 and
 //! CWBVH, its own two-sided Möller–Trumbore test), `bvh` 0.13 (svenstaro; its triangle test
 //! culls back faces, so it traces with this benchmark's two-sided Möller–Trumbore from
 //! [`crate::mt`], as the workload's triangles are two-sided) and, with the `tinybvh` feature,
@@ -11,6 +12,8 @@
 //! Embree's call takes the raw ray record; the other peers' rays are converted to their ray
 //! type before timing, and that conversion (`setup_ms`) is added to their per-ray figure.
 
+#[cfg(feature = "embree")]
+use crate::embree::Settings;
 use crate::mt::moller_trumbore;
 use crate::ours::{mrays, RunOptions};
 use crate::results::TraceRow;
@@ -37,6 +40,8 @@ pub enum Peer {
     EmbreeHigh,
     /// Embree 3, `RTC_BUILD_QUALITY_MEDIUM` (SAH), `rtcIntersect1`.
     EmbreeMedium,
+    /// Embree 3, `RTC_BUILD_QUALITY_HIGH` with `RTC_SCENE_FLAG_ROBUST`, `rtcIntersect1`.
+    EmbreeHighRobust,
 }
 
 impl Peer {
@@ -47,6 +52,8 @@ impl Peer {
         Self::EmbreeHigh,
         #[cfg(feature = "embree")]
         Self::EmbreeMedium,
+        #[cfg(feature = "embree")]
+        Self::EmbreeHighRobust,
         #[cfg(feature = "tinybvh")]
         Self::TinybvhBvh2,
         Self::ObvhsBvh2,
@@ -64,13 +71,17 @@ impl Peer {
             Self::TinybvhBvh2 => "tinybvh 1.6 BVH2",
             Self::EmbreeHigh => "Embree 3 HIGH",
             Self::EmbreeMedium => "Embree 3 MEDIUM",
+            Self::EmbreeHighRobust => "Embree 3 HIGH robust",
         }
     }
 
-    /// True for Embree (either quality): the peer the headline compares with.
+    /// True for Embree (any of its settings).
     #[must_use]
     pub fn is_embree(self) -> bool {
-        matches!(self, Self::EmbreeHigh | Self::EmbreeMedium)
+        matches!(
+            self,
+            Self::EmbreeHigh | Self::EmbreeMedium | Self::EmbreeHighRobust
+        )
     }
 
     fn builder(self) -> &'static str {
@@ -79,6 +90,7 @@ impl Peer {
             Self::SvenstaroBvh | Self::TinybvhBvh2 => "binned SAH",
             Self::EmbreeHigh => "SAH + spatial splits",
             Self::EmbreeMedium => "SAH",
+            Self::EmbreeHighRobust => "SAH (robust mode)",
         }
     }
 
@@ -88,6 +100,7 @@ impl Peer {
             Self::SvenstaroBvh => "Möller–Trumbore (bench)",
             Self::TinybvhBvh2 => "Möller–Trumbore (tinybvh)",
             Self::EmbreeHigh | Self::EmbreeMedium => "Embree's",
+            Self::EmbreeHighRobust => "Embree's robust",
         }
     }
 }
@@ -124,13 +137,13 @@ pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Op
         #[cfg(not(feature = "tinybvh"))]
         Peer::TinybvhBvh2 => return None,
         #[cfg(feature = "embree")]
-        Peer::EmbreeHigh => embree_peer::run(crate::embree::Quality::High, &scene.mesh, set, opts)?,
+        Peer::EmbreeHigh => embree_peer::run(Settings::HIGH, &scene.mesh, set, opts)?,
         #[cfg(feature = "embree")]
-        Peer::EmbreeMedium => {
-            embree_peer::run(crate::embree::Quality::Medium, &scene.mesh, set, opts)?
-        }
+        Peer::EmbreeMedium => embree_peer::run(Settings::MEDIUM, &scene.mesh, set, opts)?,
+        #[cfg(feature = "embree")]
+        Peer::EmbreeHighRobust => embree_peer::run(Settings::HIGH_ROBUST, &scene.mesh, set, opts)?,
         #[cfg(not(feature = "embree"))]
-        Peer::EmbreeHigh | Peer::EmbreeMedium => return None,
+        Peer::EmbreeHigh | Peer::EmbreeMedium | Peer::EmbreeHighRobust => return None,
     };
     let n = m.hits.len();
     Some(TraceRow {
@@ -182,17 +195,17 @@ pub fn run(peer: Peer, scene: &BenchScene, set: &RaySet, opts: RunOptions) -> Op
 #[cfg(feature = "embree")]
 mod embree_peer {
     use super::{empty_measured, PeerMeasured};
-    use crate::embree::{flat_records, Device, Geometry, Quality, Scene};
+    use crate::embree::{flat_records, Device, Geometry, Scene, Settings};
     use crate::ours::RunOptions;
     use crate::workload::RaySet;
     use host::obj::Mesh;
     use host::trace::median;
 
-    /// `runs` builds at `quality`, each followed by a closest-hit pass over the set's records
+    /// `runs` builds with `settings`, each followed by a closest-hit pass over the set's records
     /// (flagged coherent for primary rays, see [`Scene::closest`]); any hit once after the
     /// last. `None` if Embree cannot make a device or refuses the scene.
     pub(super) fn run(
-        quality: Quality,
+        settings: Settings,
         mesh: &Mesh,
         set: &RaySet,
         opts: RunOptions,
@@ -203,7 +216,7 @@ mod embree_peer {
         let (mut builds, mut closest) = (Vec::new(), Vec::new());
         let mut m = empty_measured();
         for run in 0..opts.runs.max(1) {
-            let (scene, built) = Scene::build(&device, &geometry, quality)?;
+            let (scene, built) = Scene::build(&device, &geometry, settings)?;
             builds.push(built.build_ms);
             let (hits, ms) = scene.closest(&flat, set.kind);
             closest.push(ms);

@@ -1,11 +1,12 @@
 //! Interleaved rounds: the headline contenders (the 4-wide and the 8-wide BVH collapsed from
 //! the SAH BVH, `f32`, leaf order, the 8-wide by both of its walks) and the peers they are
 //! compared with trace one ray set in alternation, round after round: ours per ray (each ray
-//! constructed from its record in the timed loop), Embree HIGH (`rtcIntersect1` on the raw
-//! records, flagged coherent on primary rays, with the `embree` feature), ours on pre-built
-//! rays, tinybvh's BVH2 on pre-built rays (with the `tinybvh` feature); then again. Each
-//! structure is built once; only tracing is timed. The per-round ratios pair like with like:
-//! ours per ray ÷ Embree (both pay their ray setup), ours pre-built ÷ tinybvh (neither does).
+//! constructed from its record in the timed loop), Embree HIGH and Embree HIGH in its robust
+//! mode (`rtcIntersect1` on the raw records, flagged coherent on primary rays, with the
+//! `embree` feature), ours on pre-built rays, tinybvh's BVH2 on pre-built rays (with the
+//! `tinybvh` feature); then again. Each structure is built once; only tracing is timed. The
+//! per-round ratios pair like with like: ours per ray ÷ Embree (both pay their ray setup),
+//! ours pre-built ÷ tinybvh (neither does).
 //!
 //! Why: on a shared VM a slow spell (another tenant's memory traffic) can last seconds to
 //! minutes, long enough to cover one contender's consecutive runs and not the other's. In
@@ -61,6 +62,8 @@ pub struct RoundsRow {
     pub ours: Vec<OursRounds>,
     /// Embree 3 HIGH, `rtcIntersect1` on the raw records (flagged coherent on primary rays).
     pub embree_mrays: Vec<f64>,
+    /// Embree 3 HIGH in its robust mode (`RTC_SCENE_FLAG_ROBUST`), traced as `embree_mrays`.
+    pub embree_robust_mrays: Vec<f64>,
     /// tinybvh's BVH2 on pre-built rays.
     pub tinybvh_mrays: Vec<f64>,
 }
@@ -135,6 +138,12 @@ impl RoundsRow {
         Pairing::of(&ours.per_ray_mrays, &self.embree_mrays)
     }
 
+    /// `ours` per ray against Embree HIGH in its robust mode (`None` without Embree).
+    #[must_use]
+    pub fn vs_embree_robust(&self, ours: &OursRounds) -> Option<Pairing> {
+        Pairing::of(&ours.per_ray_mrays, &self.embree_robust_mrays)
+    }
+
     /// `ours` pre-built against tinybvh (`None` without tinybvh).
     #[must_use]
     pub fn vs_tinybvh(&self, ours: &OursRounds) -> Option<Pairing> {
@@ -202,6 +211,7 @@ pub fn run(
         ray_count: prepared.rays.len(),
         ours,
         embree_mrays: figures.embree,
+        embree_robust_mrays: figures.embree_robust,
         tinybvh_mrays: figures.tinybvh,
     })
 }
@@ -258,6 +268,7 @@ struct Figures {
     per_ray: [Vec<f64>; 3],
     prebuilt: [Vec<f64>; 3],
     embree: Vec<f64>,
+    embree_robust: Vec<f64>,
     tinybvh: Vec<f64>,
 }
 
@@ -266,7 +277,8 @@ impl Alternate<'_> {
         let n = self.prepared.rays.len();
         let mut figures = Figures::default();
         let inputs = EmbreeInputs::new(self.scene, self.set, self.with_peers);
-        let embree = inputs.build();
+        let embree = inputs.build(false);
+        let embree_robust = inputs.build(true);
         let coherent = Coherent(second);
         let round = |figures: &mut Figures| {
             let [per_ray_a, per_ray_b, per_ray_c] = &mut figures.per_ray;
@@ -278,6 +290,9 @@ impl Alternate<'_> {
             ));
             if let Some(e) = &embree {
                 figures.embree.push(e.trace());
+            }
+            if let Some(e) = &embree_robust {
+                figures.embree_robust.push(e.trace());
             }
             let [prebuilt_a, prebuilt_b, prebuilt_c] = &mut figures.prebuilt;
             prebuilt_a.push(mrays(n, trace_closest(first, self.prepared).1));
@@ -307,8 +322,8 @@ impl Alternate<'_> {
 }
 
 /// Embree HIGH for the rounds, with the `embree` feature: a device, the scene's geometry and
-/// flat records ([`EmbreeInputs::new`]), and the scene built once over them
-/// ([`EmbreeInputs::build`]). Without the feature, nothing.
+/// flat records ([`EmbreeInputs::new`]), and a scene built once over them in Embree's default
+/// mode and once in its robust mode ([`EmbreeInputs::build`]). Without the feature, nothing.
 #[cfg(feature = "embree")]
 struct EmbreeInputs {
     device: Option<crate::embree::Device>,
@@ -333,10 +348,16 @@ impl EmbreeInputs {
         }
     }
 
-    fn build(&self) -> Option<EmbreeTracer<'_>> {
-        use crate::embree::{Quality, Scene};
+    /// The scene at HIGH quality, in the robust mode if `robust`.
+    fn build(&self, robust: bool) -> Option<EmbreeTracer<'_>> {
+        use crate::embree::{Scene, Settings};
         let device = self.device.as_ref()?;
-        let (scene, _) = Scene::build(device, &self.geometry, Quality::High)?;
+        let settings = if robust {
+            Settings::HIGH_ROBUST
+        } else {
+            Settings::HIGH
+        };
+        let (scene, _) = Scene::build(device, &self.geometry, settings)?;
         Some(EmbreeTracer {
             scene,
             flat: &self.flat,
@@ -369,7 +390,7 @@ impl EmbreeInputs {
         Self
     }
 
-    fn build(&self) -> Option<EmbreeTracer> {
+    fn build(&self, _robust: bool) -> Option<EmbreeTracer> {
         None
     }
 }
