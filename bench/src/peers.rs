@@ -1,10 +1,10 @@
 //! Peers measured in the same run, on the same triangles and rays: with the `embree` feature,
 //! Embree 3 at HIGH and MEDIUM build quality, and at HIGH in its robust mode
-//! ([`crate::embree`]); `obvhs` 0.4 (BVH2 and
-//! CWBVH, its own two-sided Möller–Trumbore test), `bvh` 0.13 (svenstaro; its triangle test
-//! culls back faces, so it traces with this benchmark's two-sided Möller–Trumbore from
-//! [`crate::mt`], as the workload's triangles are two-sided) and, with the `tinybvh` feature,
-//! tinybvh 1.6.8's scalar BVH2 (C++, through `tinybvh-rs`).
+//! ([`crate::embree`]); `obvhs` 0.4 (BVH2 and CWBVH, its own two-sided Möller–Trumbore test),
+//! `bvh` 0.13 (svenstaro; its triangle test culls back faces, so it traces with this
+//! benchmark's two-sided Möller–Trumbore from [`crate::mt`], as the workload's triangles are
+//! two-sided) and, with the `tinybvh` feature, tinybvh 1.6.8's scalar BVH2 (C++, through
+//! `tinybvh-rs`).
 //!
 //! Each peer is used as its documentation shows, single-threaded (no rayon features; Embree's
 //! device on one thread): build from the triangle list, then one query per ray. Times and
@@ -40,7 +40,8 @@ pub enum Peer {
     EmbreeHigh,
     /// Embree 3, `RTC_BUILD_QUALITY_MEDIUM` (SAH), `rtcIntersect1`.
     EmbreeMedium,
-    /// Embree 3, `RTC_BUILD_QUALITY_HIGH` with `RTC_SCENE_FLAG_ROBUST`, `rtcIntersect1`.
+    /// Embree 3, `RTC_BUILD_QUALITY_HIGH` with `RTC_SCENE_FLAG_ROBUST` (which builds without
+    /// spatial splits), `rtcIntersect1`.
     EmbreeHighRobust,
 }
 
