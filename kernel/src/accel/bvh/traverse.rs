@@ -46,8 +46,13 @@ impl<S: Scalar, P: Primitive<S>> Bvh<'_, S, P> {
                     let [ta, tb] = S::slab_pair(rd, (&a.lo, &a.hi), (&b.lo, &b.hi), t_min, best.0);
                     match (ta, tb) {
                         (Some(ta), Some(tb)) => {
-                            let (near, far, t_far) =
-                                if tb < ta { (b, l, ta) } else { (a, l + 1, tb) };
+                            // Any hit: the first child first, unordered (the answer does not
+                            // depend on the order of the visits).
+                            let (near, far, t_far) = if !any && tb < ta {
+                                (b, l, ta)
+                            } else {
+                                (a, l + 1, tb)
+                            };
                             // Cannot fail (see above); a failed push would only skip `far`.
                             let _ = stack.push((far as u32, t_far));
                             node = near;

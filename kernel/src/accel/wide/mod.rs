@@ -3,7 +3,8 @@
 //!
 //! Each [`WideNode`] holds the boxes of up to four (eight) children side by side, so traversal
 //! tests them at once (one vector lane per child, `Numerics::slab4`, twice for eight children
-//! or once in 256-bit lanes where the CPU has AVX) and visits the hit children nearest first.
+//! or once in 256-bit lanes where the CPU has AVX) and visits the hit children nearest first
+//! (any hit: in slot order, see the walks).
 //!
 //! The collapse chooses which BVH2 nodes become wide nodes and which small subtrees become
 //! leaves (of at most as many primitives as the BVH2's largest leaf) by minimising the surface

@@ -1,6 +1,6 @@
-//! Stack-based traversal of the 4-wide tree, nearest child first. One routine serves closest
-//! hit and any hit. The query API of every wide tree is here too; `traverse8.rs` walks the
-//! 8-wide one.
+//! Stack-based traversal of the 4-wide tree, nearest child first (any hit: the first hit child
+//! in slot order; see `traverse8.rs`). One routine serves closest hit and any hit. The query
+//! API of every wide tree is here too; `traverse8.rs` walks the 8-wide one.
 
 use super::{Bvh4, WideBvh};
 use crate::accel::bvh::{test_leaf, LeafPrims, MAX_DEPTH};
@@ -149,6 +149,18 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                                 4 => (node.child[2], node.count[2]),
                                 _ => (node.child[3], node.count[3]),
                             };
+                            continue 'walk;
+                        }
+                        if ANY {
+                            // Any hit: no ordering (see the 8-wide walk).
+                            let mut rest = others;
+                            while rest != 0 {
+                                let i = rest.trailing_zeros() as usize & 3;
+                                let _ = stack.push((node.child[i], node.count[i], t[i]));
+                                rest &= rest - 1;
+                            }
+                            let i = hit.trailing_zeros() as usize & 3;
+                            (child, count) = (node.child[i], node.count[i]);
                             continue 'walk;
                         }
                         if others & (others - 1) == 0 {

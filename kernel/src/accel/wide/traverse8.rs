@@ -1,7 +1,7 @@
-//! Stack-based traversal of the 8-wide tree, nearest child first. One routine serves closest
-//! hit and any hit. The eight boxes of a node are tested in two 4-lane halves
-//! (`Numerics::slab8`), or in the 256-bit lanes of one AVX2 vector (`Numerics::slab8_avx2`)
-//! where the CPU has it: the same bits either way.
+//! Stack-based traversal of the 8-wide tree, nearest child first (any hit: the first hit child
+//! in slot order, below). One routine serves closest hit and any hit. The eight boxes of a node
+//! are tested in two 4-lane halves (`Numerics::slab8`), or in the 256-bit lanes of one AVX2
+//! vector (`Numerics::slab8_avx2`) where the CPU has it: the same bits either way.
 
 use super::traverse::{pop_in_reach, Walk};
 use super::Bvh8;
@@ -128,6 +128,19 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
                                 64 => (node.child[6], node.count[6]),
                                 _ => (node.child[7], node.count[7]),
                             };
+                            continue 'walk;
+                        }
+                        if ANY {
+                            // Any hit: the answer does not depend on the order of the
+                            // visits, so no ordering: the first hit child in slot order
+                            // next, the others pushed.
+                            let mut rest = others;
+                            while rest != 0 {
+                                let _ = stack.push(slot(rest.trailing_zeros()));
+                                rest &= rest - 1;
+                            }
+                            let first = slot(hit.trailing_zeros());
+                            (child, count) = (first.0, first.1);
                             continue 'walk;
                         }
                         if others & (others - 1) == 0 {
