@@ -551,6 +551,11 @@ impl Numerics for I16F16 {
     }
 
     #[inline(always)]
+    fn order_bits(t: Self) -> u32 {
+        t.0 as u32
+    }
+
+    #[inline(always)]
     fn triangle_t(r: &FixedRay, v: &[[Self; 3]; 3], t_min: Self, t_max: Self) -> Option<Self> {
         let ([eu, ev, ew], [a, b, c]) = r.edges(v);
         if (eu < 0 || ev < 0 || ew < 0) && (eu > 0 || ev > 0 || ew > 0) {

@@ -772,6 +772,11 @@ impl Numerics for f32 {
     }
 
     #[inline(always)]
+    fn order_bits(t: f32) -> u32 {
+        t.to_bits()
+    }
+
+    #[inline(always)]
     fn widen(t: f32) -> f32 {
         // Only non-negative ends matter (t_near >= t_min >= 0); negative ones stay negative.
         // Multiplying keeps ±inf as they are.

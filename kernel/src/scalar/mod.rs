@@ -180,6 +180,11 @@ pub(crate) mod sealed {
         /// `widen(t)`.
         #[must_use]
         fn widen(t: Self) -> Self;
+        /// Bits that order entry distances `t >= +0` as the distances are ordered (`f32`: the
+        /// IEEE bits; fixed point: the raw integer): `a < b` gives
+        /// `order_bits(a) <= order_bits(b)`. The 8-wide walk's sort keys: visit order only.
+        #[must_use]
+        fn order_bits(t: Self) -> u32;
         /// The per-axis part of `Numerics::slab`, for traversals that walk cells plane by plane
         /// (the uniform grid): `(entry, exit)` of the ray between the planes `lo <= hi` of `axis`,
         /// the exit already widened.

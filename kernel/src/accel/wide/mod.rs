@@ -27,6 +27,8 @@
 
 mod collapse;
 mod node;
+#[cfg(target_arch = "x86_64")]
+mod order;
 mod parts;
 mod refit;
 mod traverse;

@@ -3,6 +3,8 @@
 //! are tested in two 4-lane halves (`Numerics::slab8`), or in the 256-bit lanes of one AVX2
 //! vector (`Numerics::slab8_avx2`) where the CPU has it: the same bits either way.
 
+#[cfg(target_arch = "x86_64")]
+use super::order::{slot_of, sorted8_avx2};
 use super::traverse::{pop_in_reach, Walk};
 use super::Bvh8;
 use crate::accel::bvh::{test_leaf, MAX_DEPTH};
@@ -37,6 +39,25 @@ impl<S: Scalar, P: Primitive<S>> Walk<S> for Bvh8<'_, S, P> {
         }
         self.walk8_baseline::<ANY, COHERENT, C>(ray, stats)
     }
+}
+
+/// `(child, count)` of slot `$slot` of `$node`, reached by a branch per slot (a jump over the
+/// slot number), not by an index computed from it: the branch predictor can then fetch the next
+/// node before the slot number is known, where an index would wait for it. (A macro, not a
+/// closure: closures compile to the index.)
+macro_rules! by_branch {
+    ($node:expr, $slot:expr) => {
+        match $slot {
+            0 => ($node.child[0], $node.count[0]),
+            1 => ($node.child[1], $node.count[1]),
+            2 => ($node.child[2], $node.count[2]),
+            3 => ($node.child[3], $node.count[3]),
+            4 => ($node.child[4], $node.count[4]),
+            5 => ($node.child[5], $node.count[5]),
+            6 => ($node.child[6], $node.count[6]),
+            _ => ($node.child[7], $node.count[7]),
+        }
+    };
 }
 
 impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
@@ -193,8 +214,6 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
                             }
                             // The nearer reached by branch again (a jump over its slot), which
                             // incoherent rays mispredict less often than a jump over the pairs.
-                            // (The slot `match`es are written out here, above and below: one
-                            // closure for the sites compiled to an index, without the jumps.)
                             let (i, j) = (hit.trailing_zeros(), others.trailing_zeros());
                             let (near, far) = if t[j as usize % 8] < t[i as usize % 8] {
                                 (j, i)
@@ -202,20 +221,13 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
                                 (i, j)
                             };
                             let _ = stack.push(slot(far));
-                            (child, count) = match near {
-                                0 => (node.child[0], node.count[0]),
-                                1 => (node.child[1], node.count[1]),
-                                2 => (node.child[2], node.count[2]),
-                                3 => (node.child[3], node.count[3]),
-                                4 => (node.child[4], node.count[4]),
-                                5 => (node.child[5], node.count[5]),
-                                6 => (node.child[6], node.count[6]),
-                                _ => (node.child[7], node.count[7]),
-                            };
+                            (child, count) = by_branch!(node, near);
                             continue 'walk;
                         }
-                        // Three or more: insertion into nearest-first order (the first of
-                        // equals first), then the farthest pushed first.
+                        // Three or more: nearest-first order, then the farthest pushed first.
+                        // By insertion (the first of equals first), except in the default
+                        // walk's AVX2 copy, which sorts in lanes (`order.rs`: no branch on the
+                        // distances; in the coherent walk it was slower).
                         if COHERENT {
                             // Slot numbers sorted, the farther children pushed by index and
                             // the nearest reached by branch, as for one and two hits. (Both
@@ -239,16 +251,19 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
                             for &(far, _) in e.get(1..n).unwrap_or_default().iter().rev() {
                                 let _ = stack.push(slot(far));
                             }
-                            (child, count) = match e[0].0 {
-                                0 => (node.child[0], node.count[0]),
-                                1 => (node.child[1], node.count[1]),
-                                2 => (node.child[2], node.count[2]),
-                                3 => (node.child[3], node.count[3]),
-                                4 => (node.child[4], node.count[4]),
-                                5 => (node.child[5], node.count[5]),
-                                6 => (node.child[6], node.count[6]),
-                                _ => (node.child[7], node.count[7]),
-                            };
+                            (child, count) = by_branch!(node, e[0].0);
+                            continue 'walk;
+                        }
+                        #[cfg(target_arch = "x86_64")]
+                        if AVX {
+                            #[allow(unsafe_code)]
+                            // SAFETY: `AVX` is set only in copies that run on a CPU with AVX2.
+                            let keys = unsafe { sorted8_avx2(&t.map(S::order_bits), hit) };
+                            let n = hit.count_ones() as usize;
+                            for &far in keys.get(1..n).unwrap_or_default().iter().rev() {
+                                let _ = stack.push(slot(slot_of(far)));
+                            }
+                            (child, count) = by_branch!(node, slot_of(keys[0]));
                             continue 'walk;
                         }
                         let mut e: [Entry<S>; 8] = [(0, 0, t_min); 8];
