@@ -82,6 +82,35 @@ mod tests {
     use super::{slot_of, sorted8_avx2};
     use crate::scalar::xorshift;
 
+    /// `Numerics::order_bits` orders non-negative distances as they are ordered, in both
+    /// modes (random pairs, many of them close or equal).
+    #[test]
+    fn order_bits_follow_the_distances() {
+        use crate::scalar::sealed::Numerics;
+        use crate::scalar::I16F16;
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..100_000 {
+            let r = xorshift(&mut state);
+            let a = f32::from_bits((r >> 33) as u32 % 0x7f80_0001); // +0 to +inf
+            let b = match r % 3 {
+                0 => a,
+                1 => f32::from_bits((a.to_bits() + (r >> 8) as u32 % 16).min(0x7f80_0000)),
+                _ => f32::from_bits((r >> 1) as u32 % 0x7f80_0001),
+            };
+            assert_eq!(
+                a.partial_cmp(&b).map(|o| o.is_le()),
+                Some(f32::order_bits(a) <= f32::order_bits(b)),
+                "{a:e} {b:e}"
+            );
+            let (x, y) = (I16F16((r >> 33) as i32), I16F16((r >> 2) as i32 & i32::MAX));
+            assert_eq!(
+                x <= y,
+                I16F16::order_bits(x) <= I16F16::order_bits(y),
+                "{x:?} {y:?}"
+            );
+        }
+    }
+
     /// The sort key of `slot` entered at order bits `bits` (module docs).
     fn key(bits: u32, slot: u32) -> u32 {
         (bits & !7) | slot
