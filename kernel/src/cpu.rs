@@ -78,6 +78,20 @@ pub(crate) fn avx2() -> bool {
     }
 }
 
+/// True if the CPU has every feature the AVX2 copy is compiled for, whatever copy queries run
+/// (for unit tests of code that only that copy calls).
+#[cfg(all(test, target_arch = "x86_64"))]
+pub(crate) fn avx2_present() -> bool {
+    #[cfg(target_feature = "avx2")]
+    {
+        true
+    }
+    #[cfg(not(target_feature = "avx2"))]
+    {
+        detect::detected()
+    }
+}
+
 #[cfg(all(target_arch = "x86_64", not(target_feature = "avx2")))]
 mod detect {
     use core::arch::x86_64::{__cpuid_count, _xgetbv, CpuidResult};

@@ -8,6 +8,19 @@
 //! hit keeps the lowest primitive id among equal distances whatever the order, and any hit asks
 //! only whether something is hit.
 
+/// The bitonic network, step by step: `(distance, takes_max)`. In a step each lane meets the
+/// lane `distance` away within its aligned group of `2·distance` (lane `i ^ distance`), and
+/// keeps the larger key where bit `i` of `takes_max` is set, else the smaller. Pairs are sorted
+/// up, down, up, down; then each half merged, up and down; then the whole merged up.
+const NETWORK: [(usize, i32); 6] = [
+    (1, 0b0110_0110),
+    (2, 0b0011_1100),
+    (1, 0b0101_1010),
+    (4, 0b1111_0000),
+    (2, 0b1100_1100),
+    (1, 0b1010_1010),
+];
+
 /// The slot number a [`sorted8_avx2`] key stands for.
 #[inline(always)]
 pub(super) fn slot_of(key: u32) -> u32 {
@@ -45,30 +58,27 @@ pub(super) unsafe fn sorted8_avx2(bits: &[u32; 8], hit: u32) -> [u32; 8] {
             slot,
         );
         let mut v = _mm256_or_si256(keys, _mm256_andnot_si256(is_hit, _mm256_set1_epi32(-1)));
-        // One compare-exchange step: each lane meets its partner at distance 1 or 2 (within
-        // 128-bit halves) or 4 (across them), and keeps the larger key where `takes_max` has
-        // its bit, else the smaller.
+        // A step of `NETWORK`: the partner by an in-lane shuffle (distance 1 or 2) or by
+        // swapping the 128-bit halves (4).
         macro_rules! exchange {
-            ($distance:literal, $takes_max:literal) => {
-                let partner = match $distance {
+            ($step:literal) => {
+                let partner = match NETWORK[$step].0 {
                     1 => _mm256_shuffle_epi32::<0b10_11_00_01>(v),
                     2 => _mm256_shuffle_epi32::<0b01_00_11_10>(v),
                     _ => _mm256_permute2x128_si256::<0x01>(v, v),
                 };
-                v = _mm256_blend_epi32::<$takes_max>(
+                v = _mm256_blend_epi32::<{ NETWORK[$step].1 }>(
                     _mm256_min_epu32(v, partner),
                     _mm256_max_epu32(v, partner),
                 );
             };
         }
-        // Pairs sorted up, down, up, down; then each half merged, up and down; then the whole
-        // merged up.
-        exchange!(1, 0b0110_0110);
-        exchange!(2, 0b0011_1100);
-        exchange!(1, 0b0101_1010);
-        exchange!(4, 0b1111_0000);
-        exchange!(2, 0b1100_1100);
-        exchange!(1, 0b1010_1010);
+        exchange!(0);
+        exchange!(1);
+        exchange!(2);
+        exchange!(3);
+        exchange!(4);
+        exchange!(5);
         let mut out = [0u32; 8];
         _mm256_storeu_si256(out.as_mut_ptr().cast(), v);
         out
@@ -77,10 +87,94 @@ pub(super) unsafe fn sorted8_avx2(bits: &[u32; 8], hit: u32) -> [u32; 8] {
 
 #[cfg(test)]
 mod tests {
-    extern crate std;
-
-    use super::{slot_of, sorted8_avx2};
+    use super::{slot_of, NETWORK};
     use crate::scalar::xorshift;
+
+    /// The sort key of `slot` entered at order bits `bits` (module docs).
+    fn key(bits: u32, slot: u32) -> u32 {
+        (bits & !7) | slot
+    }
+
+    /// The keys [`super::sorted8_avx2`] sorts: the hit slots' keys, `u32::MAX` elsewhere.
+    fn keys(bits: &[u32; 8], hit: u32) -> [u32; 8] {
+        core::array::from_fn(|i| {
+            if hit >> i & 1 == 1 {
+                key(bits[i], i as u32)
+            } else {
+                u32::MAX
+            }
+        })
+    }
+
+    /// [`NETWORK`] run lane by lane, as its docs read.
+    fn network(mut v: [u32; 8]) -> [u32; 8] {
+        for (distance, takes_max) in NETWORK {
+            let before = v;
+            for (i, x) in v.iter_mut().enumerate() {
+                let partner = before[i ^ distance];
+                *x = if takes_max >> i & 1 == 1 {
+                    before[i].max(partner)
+                } else {
+                    before[i].min(partner)
+                };
+            }
+        }
+        v
+    }
+
+    /// Every hit mask, random order bits (a third from four values: ties, which the slot
+    /// number breaks): `(bits, hit)`.
+    fn cases() -> impl Iterator<Item = ([u32; 8], u32)> {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        (0u32..256).flat_map(move |hit| {
+            let all: [[u32; 8]; 200] = core::array::from_fn(|_| {
+                core::array::from_fn(|_| {
+                    let r = xorshift(&mut state);
+                    if r % 3 == 0 {
+                        ((r >> 8) % 4) as u32 * 8
+                    } else {
+                        (r >> 32) as u32
+                    }
+                })
+            });
+            all.into_iter().map(move |bits| (bits, hit))
+        })
+    }
+
+    /// The network sorts: its output is the keys in ascending order, whose first
+    /// `hit.count_ones()` name every hit slot once.
+    #[test]
+    fn network_sorts_the_hit_keys() {
+        for (bits, hit) in cases() {
+            let got = network(keys(&bits, hit));
+            let mut want = keys(&bits, hit);
+            want.sort_unstable();
+            assert_eq!(got, want, "hit {hit:08b}, bits {bits:x?}");
+            let n = hit.count_ones() as usize;
+            let seen = got[..n].iter().fold(0u32, |m, &k| m | 1 << slot_of(k));
+            assert_eq!(seen, hit);
+        }
+    }
+
+    /// The AVX2 lanes do what the network's table says, on a CPU that has them (the only
+    /// CPUs the traversal calls them on; on others `network_sorts_the_hit_keys` still checks
+    /// the table).
+    #[test]
+    fn avx2_lanes_run_the_network() {
+        if !crate::cpu::avx2_present() {
+            return;
+        }
+        for (bits, hit) in cases() {
+            #[allow(unsafe_code)]
+            // SAFETY: the CPU has AVX2 (checked above).
+            let got = unsafe { super::sorted8_avx2(&bits, hit) };
+            assert_eq!(
+                got,
+                network(keys(&bits, hit)),
+                "hit {hit:08b}, bits {bits:x?}"
+            );
+        }
+    }
 
     /// `Numerics::order_bits` orders non-negative distances as they are ordered, in both
     /// modes (random pairs, many of them close or equal).
@@ -108,54 +202,6 @@ mod tests {
                 I16F16::order_bits(x) <= I16F16::order_bits(y),
                 "{x:?} {y:?}"
             );
-        }
-    }
-
-    /// The sort key of `slot` entered at order bits `bits` (module docs).
-    fn key(bits: u32, slot: u32) -> u32 {
-        (bits & !7) | slot
-    }
-
-    /// The network against a plain sort of the same keys, on every hit mask and random order
-    /// bits (many equal, to exercise the slot tie-break).
-    #[test]
-    fn network_sorts_the_hit_keys() {
-        if !std::is_x86_feature_detected!("avx2") {
-            // The traversal calls the network only on a CPU with AVX2.
-            std::println!("skipped: no AVX2 on this CPU");
-            return;
-        }
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        for hit in 0u32..256 {
-            for _ in 0..200 {
-                let bits: [u32; 8] = core::array::from_fn(|_| {
-                    let r = xorshift(&mut state);
-                    // A third of the lanes from a handful of values (ties), the rest anything.
-                    if r % 3 == 0 {
-                        ((r >> 8) % 4) as u32 * 8
-                    } else {
-                        (r >> 32) as u32
-                    }
-                });
-                let mut want: [u32; 8] = core::array::from_fn(|i| {
-                    if hit >> i & 1 == 1 {
-                        key(bits[i], i as u32)
-                    } else {
-                        u32::MAX
-                    }
-                });
-                want.sort_unstable();
-                // SAFETY: AVX2 is present (checked above).
-                #[allow(unsafe_code)]
-                let got = unsafe { sorted8_avx2(&bits, hit) };
-                assert_eq!(got, want, "hit {hit:08b}, bits {bits:x?}");
-                let n = hit.count_ones() as usize;
-                let mut seen = 0u32;
-                for &k in &got[..n] {
-                    seen |= 1 << slot_of(k);
-                }
-                assert_eq!(seen, hit);
-            }
         }
     }
 }
