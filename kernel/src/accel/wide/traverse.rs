@@ -19,9 +19,9 @@ use crate::scalar::Scalar;
 /// a node at depth `d`, and at most `3·d + 3 <= 3·MAX_DEPTH` after it has pushed.
 const STACK: usize = 3 * MAX_DEPTH;
 
-/// A child to visit: `(child, count)` as in [`super::Node4`]'s slots (count 0: the node `child`;
-/// otherwise the leaf `prim_ids[child..child + count]`), and its entry distance.
-type Entry<S> = (u32, u32, S);
+/// A child to visit: `(child, count)` as in a [`super::WideNode`]'s slots (count 0: the node
+/// `child`; otherwise the leaf `prim_ids[child..child + count]`), and its entry distance.
+pub(super) type Entry<S> = (u32, u32, S);
 
 /// Compare-exchange: `e[i]` before `e[j]` unless `e[j]` is strictly nearer.
 #[inline(always)]
@@ -135,6 +135,10 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                     }
                     let (hit, t) = S::slab4(rd, &node.lo, &node.hi, t_min, best.0);
                     let hit = hit & used;
+                    let slot = |i: u32| {
+                        let i = i as usize & 3;
+                        (node.child[i], node.count[i], t[i])
+                    };
                     // None hit: fall through to the pop below.
                     if hit != 0 {
                         let others = hit & (hit - 1);
@@ -152,23 +156,15 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                             continue 'walk;
                         }
                         if ANY {
-                            // Any hit: no ordering (see the 8-wide walk).
-                            let mut rest = others;
-                            while rest != 0 {
-                                let i = rest.trailing_zeros() as usize & 3;
-                                let _ = stack.push((node.child[i], node.count[i], t[i]));
-                                rest &= rest - 1;
-                            }
-                            let i = hit.trailing_zeros() as usize & 3;
-                            (child, count) = (node.child[i], node.count[i]);
+                            // Any hit: no ordering.
+                            (child, count) = first_in_slot_order(&mut stack, hit, slot);
                             continue 'walk;
                         }
                         if others & (others - 1) == 0 {
                             // Two: visit the nearer (the first on a tie), push the other.
                             // Slots by branch again (see above).
-                            let pair = |i: usize, j: usize| {
-                                let a = (node.child[i], node.count[i], t[i]);
-                                let b = (node.child[j], node.count[j], t[j]);
+                            let pair = |i: u32, j: u32| {
+                                let (a, b) = (slot(i), slot(j));
                                 if b.2 < a.2 {
                                     (b, a)
                                 } else {
@@ -192,9 +188,8 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
                         let mut n = 0usize;
                         let mut rest = hit;
                         while rest != 0 {
-                            let i = rest.trailing_zeros() as usize & 3;
+                            e[n & 3] = slot(rest.trailing_zeros());
                             rest &= rest - 1;
-                            e[n & 3] = (node.child[i], node.count[i], t[i]);
                             n += 1;
                         }
                         sort_nearest_first(&mut e, n);
@@ -222,11 +217,29 @@ impl<S: Scalar, P: Primitive<S>> Bvh4<'_, S, P> {
     }
 }
 
+/// Any hit's visit order: the hit children in slot order, not by distance (whether something
+/// is hit does not depend on the order). Pushes every child in `hit` (not empty) but the first
+/// and returns the first's `(child, count)`; `slot(i)` is slot `i`'s entry.
+#[inline(always)]
+pub(super) fn first_in_slot_order<S: Scalar, const N: usize>(
+    stack: &mut heapless::Vec<Entry<S>, N>,
+    hit: u32,
+    slot: impl Fn(u32) -> Entry<S>,
+) -> (u32, u32) {
+    let mut rest = hit & hit.wrapping_sub(1);
+    while rest != 0 {
+        let _ = stack.push(slot(rest.trailing_zeros()));
+        rest &= rest - 1;
+    }
+    let (child, count, _) = slot(hit.trailing_zeros());
+    (child, count)
+}
+
 /// Pops entries until one is still in reach of the best hit so far (entered by
 /// `widen(best_t)`): its `(child, count)`; `None` once the stack is empty.
 #[inline(always)]
 pub(super) fn pop_in_reach<S: Scalar, const N: usize>(
-    stack: &mut heapless::Vec<(u32, u32, S), N>,
+    stack: &mut heapless::Vec<Entry<S>, N>,
     best_t: S,
 ) -> Option<(u32, u32)> {
     while let Some((child, count, t_near)) = stack.pop() {

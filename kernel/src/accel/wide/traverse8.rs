@@ -5,7 +5,7 @@
 
 #[cfg(target_arch = "x86_64")]
 use super::order::{slot_of, sorted8_avx2};
-use super::traverse::{pop_in_reach, Walk};
+use super::traverse::{first_in_slot_order, pop_in_reach, Entry, Walk};
 use super::Bvh8;
 use crate::accel::bvh::{test_leaf, MAX_DEPTH};
 use crate::accel::Counters;
@@ -19,9 +19,6 @@ use crate::scalar::Scalar;
 /// So the stack holds at most `7·d` entries on entering a node at depth `d`, and at most
 /// `7·d + 7 <= 7·MAX_DEPTH` after it has pushed.
 const STACK: usize = 7 * MAX_DEPTH;
-
-/// A child to visit: `(child, count)` as in a [`super::Node8`]'s slots, and its entry distance.
-type Entry<S> = (u32, u32, S);
 
 impl<S: Scalar, P: Primitive<S>> Walk<S> for Bvh8<'_, S, P> {
     /// Runs the copy of [`Bvh8::walk8`] that [`crate::cpu`] selects.
@@ -152,16 +149,8 @@ impl<S: Scalar, P: Primitive<S>> Bvh8<'_, S, P> {
                             continue 'walk;
                         }
                         if ANY {
-                            // Any hit: the answer does not depend on the order of the
-                            // visits, so no ordering: the first hit child in slot order
-                            // next, the others pushed.
-                            let mut rest = others;
-                            while rest != 0 {
-                                let _ = stack.push(slot(rest.trailing_zeros()));
-                                rest &= rest - 1;
-                            }
-                            let first = slot(hit.trailing_zeros());
-                            (child, count) = (first.0, first.1);
+                            // Any hit: no ordering.
+                            (child, count) = first_in_slot_order(&mut stack, hit, slot);
                             continue 'walk;
                         }
                         if others & (others - 1) == 0 {
