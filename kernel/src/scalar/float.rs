@@ -73,6 +73,12 @@ enum Axis {
 }
 
 impl Axis {
+    /// The axis of index `i` (0, 1, 2; anything else is z).
+    #[inline(always)]
+    fn from_index(i: u32) -> Axis {
+        const AXES: [Axis; 4] = [Axis::X, Axis::Y, Axis::Z, Axis::Z];
+        AXES[(i & 3) as usize]
+    }
     /// The two other axes, in cyclic order after `self`.
     fn following(self) -> (Axis, Axis) {
         const CYCLE: [Axis; 5] = [Axis::X, Axis::Y, Axis::Z, Axis::X, Axis::Y];
@@ -84,6 +90,27 @@ impl Axis {
 #[inline(always)]
 fn axis(v: &[f32; 3], k: Axis) -> f32 {
     v[k as usize]
+}
+
+/// `v[k]` of a vector in lanes. Hosted targets pick the lane by selects, with neither a branch
+/// (a ray's axes follow its direction, which the predictor cannot guess) nor a lane read back
+/// from memory; bare-metal targets index (less flash).
+#[inline(always)]
+fn lane(v: &[f32; 4], k: Axis) -> f32 {
+    if cfg!(target_os = "none") {
+        return v[k as usize];
+    }
+    let [x, y, z, _] = v.map(f32::to_bits);
+    let x_or_y = select_bits(k == Axis::X, x, y);
+    f32::from_bits(select_bits(k == Axis::Z, z, x_or_y))
+}
+
+/// `if take_first { first } else { second }` as bit operations, which compilers turn into a
+/// conditional move where a plain `if` may become a branch.
+#[inline(always)]
+fn select_bits(take_first: bool, first: u32, second: u32) -> u32 {
+    let mask = 0u32.wrapping_sub(u32::from(take_first));
+    (first & mask) | (second & !mask)
 }
 
 /// `[x, y, z, z]`: a 3-vector as the four lanes of an [`F4`].
@@ -145,9 +172,10 @@ fn check_coord(x: f32) -> Result<(), PointError> {
 /// The float just below 1, `1 - 2^-24`: its correctly rounded square root is itself.
 const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
 
-/// Unit vector along `d` in `f32`, z repeated in lane 3: [`normalized`]`(d)`, bit for bit, but
-/// found without a square root or a division when `d` is already a unit vector as [`normalized`]
-/// sees it (most unit vectors a caller rounds to `f32`).
+/// Unit vector along `d` in `f32` and its reciprocal `1 / dir` (lane-wise IEEE quotients), z
+/// repeated in lane 3: [`normalized`]`(d)`, bit for bit, but found by one division, without
+/// the scaling and the square root, when `d` is a unit vector as [`normalized`] sees it or one
+/// ulp of length short of one (most unit vectors a caller rounds to `f32`).
 ///
 /// That is when `q = (dx·dx + dy·dy) + dz·dz`, in `f32`, is 1 or its upper neighbour
 /// `1 + 2^-23`: then [`normalized`] returns `d` itself. It scales `d` by a power of two `k`,
@@ -158,19 +186,31 @@ const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
 /// and each quotient `(k·d_i) / k` is `d_i`. When `q` is the float below 1, `1 - 2^-24` (also
 /// common among rounded unit vectors), the length is likewise `k·sqrtf(q) = k·q` (the square
 /// root lies just under the midpoint `1 - 2^-25` and rounds to `q`), so the quotients are
-/// `d_i / q`: one division, without the scaling and the square root. Non-finite components
-/// make `q` non-finite and go to [`normalized`], which rejects them.
+/// `d_i / q`. Which of the two a ray is in is not predictable, so hosted targets compute both
+/// (and both reciprocals, so that the traversal's first box test need not wait for `q`) and
+/// choose without a branch; bare-metal cores, which pay little for a branch but much for a
+/// division, branch. Non-finite components make `q` non-finite and go to [`normalized`],
+/// which rejects them.
 #[cfg_attr(not(target_os = "none"), inline(always))]
-fn unit_dir(d: [f32; 3]) -> Result<[f32; 4], RayError> {
+fn unit_dir_and_inverse(d: [f32; 3]) -> Result<(F4, F4), RayError> {
+    let one = F4::splat(1.0);
     let q = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-    // `q` is 1 (bits 0x3f80_0000) or the next float up: one unsigned comparison.
-    if q.to_bits().wrapping_sub(1.0f32.to_bits()) <= 1 {
-        return Ok(lanes(d));
+    // `q` is `BELOW_ONE`, 1 or the next float up (consecutive bits): one unsigned comparison.
+    let above_below_one = q.to_bits().wrapping_sub(BELOW_ONE.to_bits());
+    if above_below_one > 2 {
+        let unit = F4::new(normalized(d)?);
+        return Ok((unit, one.div(unit)));
     }
-    if q == BELOW_ONE {
-        return Ok(vector(&d).div(F4::splat(BELOW_ONE)).to_array());
+    let below = above_below_one == 0;
+    let (given, shortened) = (vector(&d), vector(&d).div(F4::splat(BELOW_ONE)));
+    if cfg!(target_os = "none") {
+        let unit = if below { shortened } else { given };
+        return Ok((unit, one.div(unit)));
     }
-    normalized(d)
+    Ok((
+        F4::select(below, shortened, given),
+        F4::select(below, one.div(shortened), one.div(given)),
+    ))
 }
 
 /// Unit vector along `d` in `f32`, z repeated in lane 3: `d` scaled by the power of two that
@@ -266,39 +306,30 @@ impl FloatRay {
         o_hi: [f32; 4],
         dir: [f32; 3],
     ) -> Result<Self, RayError> {
-        // Stored whole before the lookups by axis below read single lanes back: split into
-        // lane stores, it stalled the ray's copy of it on store forwarding.
-        let mut dir_lanes = [0.0f32; 4];
-        F4::new(unit_dir(dir)?).store(&mut dir_lanes);
-        let dir = dir_lanes;
-        // Four quotients in one vector division (each lane the same IEEE quotient).
-        let inv = F4::splat(1.0).div(F4::new(dir)).to_array();
+        let (dir, inv) = unit_dir_and_inverse(dir)?;
+        let (dir, inv) = (dir.to_array(), inv.to_array());
 
-        // Watertight test: kz is the dominant axis; swapping kx/ky keeps the winding.
+        // Watertight test: kz is the dominant axis; swapping kx/ky keeps the winding. Chosen
+        // without branches: incoherent rays' dominant axes are not predictable.
         let a = [abs(dir[0]), abs(dir[1]), abs(dir[2])];
-        let kz = if a[0] >= a[1] && a[0] >= a[2] {
-            Axis::X
-        } else if a[1] >= a[2] {
-            Axis::Y
-        } else {
-            Axis::Z
-        };
+        let y_or_z = select_bits(a[1] >= a[2], Axis::Y as u32, Axis::Z as u32);
+        let kz = Axis::from_index(select_bits((a[0] >= a[1]) & (a[0] >= a[2]), 0, y_or_z));
         let (mut kx, mut ky) = kz.following();
-        if dir[kz as usize] < 0.0 {
+        if lane(&dir, kz) < 0.0 {
             core::mem::swap(&mut kx, &mut ky);
         }
-        let sz = inv[kz as usize]; // 1 / dir[kz], the same quotient
-        let shear = [dir[kx as usize] * sz, dir[ky as usize] * sz, sz];
-        let k = [kx, ky, kz];
+        let sz = lane(&inv, kz); // 1 / dir[kz], the same quotient
+        let shear = [lane(&dir, kx) * sz, lane(&dir, ky) * sz, sz];
+        let origin = lanes(origin);
         Ok(Self {
-            origin: lanes(origin),
+            origin,
             dir,
             inv,
             o_lo,
             o_hi,
-            k,
+            k: [kx, ky, kz],
             shear,
-            o_perm: [axis(&origin, kx), axis(&origin, ky), axis(&origin, kz)],
+            o_perm: [lane(&origin, kx), lane(&origin, ky), lane(&origin, kz)],
         })
     }
 
@@ -917,8 +948,9 @@ mod tests {
 
     use crate::scalar::xorshift as next;
 
-    /// `unit_dir` takes `d` as given exactly when `normalized` returns it bit for bit, and its
-    /// quotient by `1 - 2^-24` is `normalized`'s: checked on unit vectors rounded from `f64`
+    /// `unit_dir_and_inverse` takes `d` as given exactly when `normalized` returns it bit for
+    /// bit, its quotient by `1 - 2^-24` is `normalized`'s, and its inverse is the quotient
+    /// `1 / dir` of that unit vector: checked on unit vectors rounded from `f64`
     /// (with tiny and zero components, of every sign and order), which take a shortcut most of
     /// the time, and on their neighbours one ulp away.
     #[test]
@@ -943,10 +975,13 @@ mod tests {
             let mut nudged = d;
             nudged[k] = step(d[k], i % 2 == 0);
             for d in [d, nudged] {
-                let (Ok(got), Ok(want)) = (unit_dir(d), normalized(d)) else {
+                let (Ok((got, inv)), Ok(want)) = (unit_dir_and_inverse(d), normalized(d)) else {
                     panic!("{d:?} rejected");
                 };
+                let got = got.to_array();
                 assert_eq!(got.map(f32::to_bits), want.map(f32::to_bits), "{d:?}");
+                let recip = want.map(|x| (1.0 / x).to_bits());
+                assert_eq!(inv.to_array().map(f32::to_bits), recip, "1 / {d:?}");
                 total += 1;
                 let q = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
                 shortcut += usize::from(q == 1.0 || q == 1.0 + f32::EPSILON);
@@ -959,7 +994,7 @@ mod tests {
         );
         assert!(below > total / 20, "q = 1 - 2^-24 {below} of {total} times");
         for bad in [[f32::NAN, 0.0, 1.0], [f32::INFINITY, 0.0, 0.0], [0.0; 3]] {
-            assert!(unit_dir(bad).is_err(), "{bad:?}");
+            assert!(unit_dir_and_inverse(bad).is_err(), "{bad:?}");
         }
     }
 

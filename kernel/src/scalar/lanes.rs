@@ -18,10 +18,11 @@ mod sse {
     // every bit pattern is a valid `f32`; `clamped_trunc`'s copies an `__m128i` into a
     // `[u32; 4]`, where every bit pattern is valid too.
     use arch::{
-        __m128, __m128i, _mm_add_ps, _mm_andnot_ps, _mm_cmple_ps, _mm_cvtepi32_ps, _mm_cvtss_f32,
-        _mm_cvttps_epi32, _mm_div_ps, _mm_loadu_si128, _mm_max_ps, _mm_min_ps, _mm_movehl_ps,
-        _mm_movemask_ps, _mm_mul_ps, _mm_set1_epi32, _mm_set1_ps, _mm_setr_ps, _mm_shuffle_ps,
-        _mm_storeu_ps, _mm_sub_epi32, _mm_sub_ps, _mm_unpackhi_ps, _mm_unpacklo_ps,
+        __m128, __m128i, _mm_add_ps, _mm_and_ps, _mm_andnot_ps, _mm_castsi128_ps, _mm_cmple_ps,
+        _mm_cvtepi32_ps, _mm_cvtss_f32, _mm_cvttps_epi32, _mm_div_ps, _mm_loadu_si128, _mm_max_ps,
+        _mm_min_ps, _mm_movehl_ps, _mm_movemask_ps, _mm_mul_ps, _mm_or_ps, _mm_set1_epi32,
+        _mm_set1_ps, _mm_setr_ps, _mm_shuffle_ps, _mm_sub_epi32, _mm_sub_ps, _mm_unpackhi_ps,
+        _mm_unpacklo_ps,
     };
     #[cfg(target_arch = "x86")]
     use core::arch::x86 as arch;
@@ -61,12 +62,6 @@ mod sse {
         #[inline(always)]
         pub(crate) fn to_array(self) -> [f32; 4] {
             unsafe { core::mem::transmute::<__m128, [f32; 4]>(self.0) }
-        }
-        /// The lanes in order, written to `out` by one vector store.
-        #[inline(always)]
-        pub(crate) fn store(self, out: &mut [f32; 4]) {
-            // SAFETY: see above; the unaligned store writes the 16 bytes of `out`.
-            unsafe { _mm_storeu_ps(out.as_mut_ptr(), self.0) }
         }
         /// Per lane `a.wrapping_sub(b) as f32` (rounded to nearest).
         #[inline(always)]
@@ -117,6 +112,15 @@ mod sse {
         pub(crate) fn zxy(self) -> Self {
             Self(unsafe { _mm_shuffle_ps::<0b10_01_00_10>(self.0, self.0) })
         }
+        /// `first` if `take_first`, else `second`, without a branch: a mask and two logic
+        /// operations, for choices the branch predictor cannot guess.
+        #[inline(always)]
+        pub(crate) fn select(take_first: bool, first: Self, second: Self) -> Self {
+            Self(unsafe {
+                let mask = _mm_castsi128_ps(_mm_set1_epi32(-i32::from(take_first)));
+                _mm_or_ps(_mm_and_ps(mask, first.0), _mm_andnot_ps(mask, second.0))
+            })
+        }
         /// Per lane `(x as i32).clamp(0, top)` for a whole `top` in `0..2^31`: the lane clamped
         /// to `[0, top]` (NaN to 0), then truncated (a floor there; exact up to 2^24).
         #[inline(always)]
@@ -156,9 +160,9 @@ mod neon {
     use core::arch::aarch64::{
         float32x4_t, uint32x4_t, vabsq_f32, vaddq_f32, vaddvq_u32, vandq_u32, vbslq_f32, vcgtq_f32,
         vcleq_f32, vcltq_f32, vcltzq_s32, vcombine_f32, vcvtq_f32_s32, vcvtq_u32_f32, vdivq_f32,
-        vdupq_n_f32, vdupq_n_s32, vget_high_f32, vgetq_lane_f32, vld1q_f32, vld1q_s32, vld1q_u32,
-        vmulq_f32, vreinterpretq_s32_f32, vst1q_f32, vst1q_u32, vsubq_f32, vsubq_s32, vzip1q_f32,
-        vzip2q_f32,
+        vdupq_n_f32, vdupq_n_s32, vdupq_n_u32, vget_high_f32, vgetq_lane_f32, vld1q_f32, vld1q_s32,
+        vld1q_u32, vmulq_f32, vreinterpretq_s32_f32, vst1q_f32, vst1q_u32, vsubq_f32, vsubq_s32,
+        vzip1q_f32, vzip2q_f32,
     };
 
     /// Four lanes in a NEON register.
@@ -201,14 +205,9 @@ mod neon {
         #[inline(always)]
         pub(crate) fn to_array(self) -> [f32; 4] {
             let mut out = [0.0f32; 4];
-            self.store(&mut out);
-            out
-        }
-        /// The lanes in order, written to `out` by one vector store.
-        #[inline(always)]
-        pub(crate) fn store(self, out: &mut [f32; 4]) {
             // SAFETY: see above; the store writes the four `f32` of `out`.
             unsafe { vst1q_f32(out.as_mut_ptr(), self.0) };
+            out
         }
         /// Per lane `a.wrapping_sub(b) as f32` (rounded to nearest).
         #[inline(always)]
@@ -260,6 +259,11 @@ mod neon {
         }
         /// Per lane `(x as i32).clamp(0, top)` for a whole `top` in `0..2^31`: the lane clamped
         /// to `[0, top]` (NaN to 0), then truncated (a floor there; exact up to 2^24).
+        #[inline(always)]
+        pub(crate) fn select(take_first: bool, first: Self, second: Self) -> Self {
+            let mask = 0u32.wrapping_sub(u32::from(take_first));
+            Self(unsafe { vbslq_f32(vdupq_n_u32(mask), first.0, second.0) })
+        }
         #[inline(always)]
         pub(crate) fn clamped_trunc(self, top: f32) -> [u32; 4] {
             let x = self.max(Self::splat(0.0)).min(Self::splat(top));
@@ -344,10 +348,6 @@ mod portable {
         pub(crate) fn to_array(self) -> [f32; 4] {
             self.0
         }
-        #[inline(always)]
-        pub(crate) fn store(self, out: &mut [f32; 4]) {
-            *out = self.0;
-        }
         /// Only the vector backends' callers need it (`wide::slab4_fixed`); here for the
         /// comparison test.
         #[cfg(test)]
@@ -391,6 +391,14 @@ mod portable {
         pub(crate) fn zxy(self) -> Self {
             let a = self.0;
             Self([a[2], a[0], a[1], a[2]])
+        }
+        #[inline(always)]
+        pub(crate) fn select(take_first: bool, first: Self, second: Self) -> Self {
+            if take_first {
+                first
+            } else {
+                second
+            }
         }
         #[inline(always)]
         pub(crate) fn clamped_trunc(self, top: f32) -> [u32; 4] {
@@ -485,14 +493,6 @@ mod tests {
                 sa.to_array().map(f32::to_bits),
                 "to_array {a:?}"
             );
-            let (mut stored_p, mut stored_s) = ([0.0f32; 4], [0.0f32; 4]);
-            pa.store(&mut stored_p);
-            sa.store(&mut stored_s);
-            assert_eq!(
-                stored_p.map(f32::to_bits),
-                stored_s.map(f32::to_bits),
-                "store {a:?}"
-            );
             same(pa.abs(), sa.abs(), "abs");
             same(pa.min(pb), sa.min(sb), "min");
             same(pa.max(pb), sa.max(sb), "max");
@@ -501,6 +501,13 @@ mod tests {
             same(pa.high_half(), sa.high_half(), "high_half");
             same(pa.yzx(), sa.yzx(), "yzx");
             same(pa.zxy(), sa.zxy(), "zxy");
+            for take_first in [true, false] {
+                same(
+                    P::select(take_first, pa, pb),
+                    S::select(take_first, sa, sb),
+                    "select",
+                );
+            }
             assert_eq!(pa.sign_mask(), sa.sign_mask(), "sign_mask {a:?}");
             same(P::splat(a[0]), S::splat(a[0]), "splat");
             assert_eq!(pa.le_mask(pb), sa.le_mask(sb), "le_mask {a:?} {b:?}");
@@ -553,11 +560,11 @@ mod tests {
         assert_eq!(lanes(a.unpack_lo(b)), [1.0f32, 5.0].map(f32::to_bits));
         assert_eq!(lanes(a.unpack_hi(b)), [3.0f32, 7.0].map(f32::to_bits));
         assert_eq!(lanes(a.high_half()), [3.0f32, 4.0].map(f32::to_bits));
-        let mut stored = [0.0f32; 4];
-        a.store(&mut stored);
-        assert_eq!(stored, [1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(a.to_array(), [1.0, 2.0, 3.0, 4.0]);
         assert_eq!(a.yzx().to_array(), [2.0, 3.0, 1.0, 2.0]);
         assert_eq!(a.zxy().to_array(), [3.0, 1.0, 2.0, 3.0]);
+        assert_eq!(F4::select(true, a, b).to_array(), [1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(F4::select(false, a, b).to_array(), [5.0, 6.0, 7.0, 8.0]);
         let c = F4::new([1.0, 9.0, f32::NAN, 4.0]);
         assert_eq!(a.le_mask(c), 0b1011);
         let sum = b.sub(F4::splat(1.0)).mul(F4::splat(2.0));
