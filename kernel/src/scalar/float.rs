@@ -79,11 +79,6 @@ impl Axis {
         const AXES: [Axis; 4] = [Axis::X, Axis::Y, Axis::Z, Axis::Z];
         AXES[(i & 3) as usize]
     }
-    /// The two other axes, in cyclic order after `self`.
-    fn following(self) -> (Axis, Axis) {
-        const CYCLE: [Axis; 5] = [Axis::X, Axis::Y, Axis::Z, Axis::X, Axis::Y];
-        (CYCLE[self as usize + 1], CYCLE[self as usize + 2])
-    }
 }
 
 /// `v[k]`.
@@ -103,6 +98,28 @@ fn lane(v: &[f32; 4], k: Axis) -> f32 {
     let [x, y, z, _] = v.map(f32::to_bits);
     let x_or_y = select_bits(k == Axis::X, x, y);
     f32::from_bits(select_bits(k == Axis::Z, z, x_or_y))
+}
+
+/// The watertight test's axes `[kx, ky, kz]` for a ray along `dir` (lanes x, y, z, z): `kz`
+/// the dominant axis (the first of equal magnitudes), `kx`, `ky` the two others in cyclic
+/// order, swapped if `dir[kz] < 0` so that the winding is kept (`dir[kz]` is never zero for a
+/// non-zero direction, so its sign bit decides). Found by integer operations on lane masks,
+/// without branches (incoherent rays' axes are not predictable) or table lookups.
+#[inline(always)]
+fn shear_axes(dir: F4) -> [Axis; 3] {
+    let a = dir.abs();
+    // Bit i: |dir_i| >= |dir_(i+1)|, and |dir_i| >= |dir_(i+2)| (indices mod 3).
+    let (ge_next, ge_after) = (a.yzx().le_mask(a), a.zxy().le_mask(a));
+    let x_dominant = ge_next & ge_after & 1;
+    let y_over_z = (ge_next >> 1) & 1;
+    // 0 if x dominates, else 1 for y (|y| >= |z|) or 2 for z.
+    let kz = (1 - x_dominant) * (2 - y_over_z);
+    let negative = (dir.sign_mask() >> kz) & 1;
+    // The axes after kz: kz + 1 and kz + 2 (mod 3), two bits each, read from one constant.
+    const AFTER: u32 = 0b00_10_01 | 0b01_00_10 << 8;
+    let (kx, ky) = ((AFTER >> (2 * kz)) & 3, (AFTER >> (8 + 2 * kz)) & 3);
+    let swap = (kx ^ ky) & 0u32.wrapping_sub(negative);
+    [kx ^ swap, ky ^ swap, kz].map(Axis::from_index)
 }
 
 /// `if take_first { first } else { second }` as bit operations, which compilers turn into a
@@ -309,15 +326,7 @@ impl FloatRay {
         let (dir, inv) = unit_dir_and_inverse(dir)?;
         let (dir, inv) = (dir.to_array(), inv.to_array());
 
-        // Watertight test: kz is the dominant axis; swapping kx/ky keeps the winding. Chosen
-        // without branches: incoherent rays' dominant axes are not predictable.
-        let a = [abs(dir[0]), abs(dir[1]), abs(dir[2])];
-        let y_or_z = select_bits(a[1] >= a[2], Axis::Y as u32, Axis::Z as u32);
-        let kz = Axis::from_index(select_bits((a[0] >= a[1]) & (a[0] >= a[2]), 0, y_or_z));
-        let (mut kx, mut ky) = kz.following();
-        if lane(&dir, kz) < 0.0 {
-            core::mem::swap(&mut kx, &mut ky);
-        }
+        let [kx, ky, kz] = shear_axes(F4::new(dir));
         let sz = lane(&inv, kz); // 1 / dir[kz], the same quotient
         let shear = [lane(&dir, kx) * sz, lane(&dir, ky) * sz, sz];
         let origin = lanes(origin);
@@ -995,6 +1004,58 @@ mod tests {
         assert!(below > total / 20, "q = 1 - 2^-24 {below} of {total} times");
         for bad in [[f32::NAN, 0.0, 1.0], [f32::INFINITY, 0.0, 0.0], [0.0; 3]] {
             assert!(unit_dir_and_inverse(bad).is_err(), "{bad:?}");
+        }
+    }
+
+    /// `shear_axes` against the definition written as branches: on every direction made of
+    /// the magnitudes 0, 1, 2 (so with ties of every kind) with either sign on each component
+    /// (`-0.0` too), and on random directions.
+    #[test]
+    fn shear_axes_are_the_dominant_axis_and_the_others_in_winding_order() {
+        let reference = |d: [f32; 3]| {
+            let a = d.map(abs);
+            let kz = if a[0] >= a[1] && a[0] >= a[2] {
+                0
+            } else if a[1] >= a[2] {
+                1
+            } else {
+                2
+            };
+            let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+            if d[kz] < 0.0 {
+                [ky, kx, kz]
+            } else {
+                [kx, ky, kz]
+            }
+        };
+        let check = |d: [f32; 3]| {
+            let got = shear_axes(F4::new(lanes(d))).map(|k| k as usize);
+            assert_eq!(got, reference(d), "{d:?}");
+        };
+        let mut tried = 0;
+        for code in 0..6usize.pow(3) {
+            let d: [f32; 3] = core::array::from_fn(|i| {
+                let digit = code / 6usize.pow(i as u32) % 6;
+                let magnitude = (digit / 2) as f32;
+                if digit % 2 == 1 {
+                    -magnitude
+                } else {
+                    magnitude
+                }
+            });
+            if d != [0.0; 3] {
+                check(d);
+                tried += 1;
+            }
+        }
+        assert!(tried > 100, "{tried} directions");
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..10_000 {
+            let d: [f32; 3] =
+                core::array::from_fn(|_| (next(&mut state) >> 40) as f32 / 8_388_608.0 - 1.0);
+            if d != [0.0; 3] {
+                check(d);
+            }
         }
     }
 
