@@ -104,7 +104,7 @@ fn lane(v: &[f32; 4], k: Axis) -> f32 {
 /// the dominant axis (the first of equal magnitudes), `kx`, `ky` the two others in cyclic
 /// order, swapped if `dir[kz] < 0` so that the winding is kept (`dir[kz]` is never zero for a
 /// non-zero direction, so its sign bit decides). Found by integer operations on lane masks,
-/// without branches (incoherent rays' axes are not predictable) or table lookups.
+/// without branches (incoherent rays' axes are not predictable).
 #[inline(always)]
 fn shear_axes(dir: F4) -> [Axis; 3] {
     let a = dir.abs();
@@ -219,7 +219,8 @@ fn unit_dir_and_inverse(d: [f32; 3]) -> Result<(F4, F4), RayError> {
         return Ok((unit, one.div(unit)));
     }
     let below = above_below_one == 0;
-    let (given, shortened) = (vector(&d), vector(&d).div(F4::splat(BELOW_ONE)));
+    let given = vector(&d);
+    let shortened = given.div(F4::splat(BELOW_ONE));
     if cfg!(target_os = "none") {
         let unit = if below { shortened } else { given };
         return Ok((unit, one.div(unit)));
@@ -324,9 +325,8 @@ impl FloatRay {
         dir: [f32; 3],
     ) -> Result<Self, RayError> {
         let (dir, inv) = unit_dir_and_inverse(dir)?;
+        let [kx, ky, kz] = shear_axes(dir);
         let (dir, inv) = (dir.to_array(), inv.to_array());
-
-        let [kx, ky, kz] = shear_axes(F4::new(dir));
         let sz = lane(&inv, kz); // 1 / dir[kz], the same quotient
         let shear = [lane(&dir, kx) * sz, lane(&dir, ky) * sz, sz];
         let origin = lanes(origin);

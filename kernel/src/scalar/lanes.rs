@@ -257,13 +257,14 @@ mod neon {
             let a = self.to_array();
             Self::new([a[2], a[0], a[1], a[2]])
         }
-        /// Per lane `(x as i32).clamp(0, top)` for a whole `top` in `0..2^31`: the lane clamped
-        /// to `[0, top]` (NaN to 0), then truncated (a floor there; exact up to 2^24).
+        /// `first` if `take_first`, else `second`, without a branch (a bit select).
         #[inline(always)]
         pub(crate) fn select(take_first: bool, first: Self, second: Self) -> Self {
             let mask = 0u32.wrapping_sub(u32::from(take_first));
             Self(unsafe { vbslq_f32(vdupq_n_u32(mask), first.0, second.0) })
         }
+        /// Per lane `(x as i32).clamp(0, top)` for a whole `top` in `0..2^31`: the lane clamped
+        /// to `[0, top]` (NaN to 0), then truncated (a floor there; exact up to 2^24).
         #[inline(always)]
         pub(crate) fn clamped_trunc(self, top: f32) -> [u32; 4] {
             let x = self.max(Self::splat(0.0)).min(Self::splat(top));
