@@ -4,7 +4,8 @@
 //! the `embree` feature, ours on pre-built rays, tinybvh with the `tinybvh` feature), with the
 //! per-round ratios against both Embree modes. Seconds per scene instead of the full
 //! benchmark's quarter hour; the full run stays the one that writes the report.
-//! `--simd-ab` compares the traversal's two compiled copies instead (`raykernel::cpu`).
+//! `--simd-ab` compares the traversal's two compiled copies instead (`raykernel::cpu`);
+//! `--split` times the rays that miss and the rays that hit apart, ours against Embree HIGH.
 //!
 //! ```text
 //! python3 ../shared/bench/make_rays.py --out /tmp/rays bunny sponza kitchen
@@ -42,6 +43,12 @@ struct Args {
     /// AVX2 copy (`raykernel::cpu`); prints the per-round ratios AVX2 ÷ baseline.
     #[arg(long)]
     simd_ab: bool,
+    /// Instead of the rounds: each ray set split into the rays ours misses and the rays it hits,
+    /// and per round the 8-wide BVH's default walk (per ray) and Embree HIGH on each part
+    /// (needs the `embree` feature). Shows whether a gap lies in what every ray pays (setup,
+    /// the top nodes) or in the descent to a hit and the triangle tests.
+    #[arg(long)]
+    split: bool,
 }
 
 /// Per round, the headline structures traced with the baseline copy of the traversal and then
@@ -103,6 +110,14 @@ fn main() -> Result<(), Error> {
     let source = RaySource::Files(args.rays.clone());
     let mut scenes = load_scenes(&args.scenes, &args.scene_names, &source)?;
     keep_every(&mut scenes, args.stride);
+    if args.split {
+        for scene in &scenes {
+            for set in &scene.ray_sets {
+                split::run(scene, set, args.rounds)?;
+            }
+        }
+        return Ok(());
+    }
     if args.simd_ab {
         for scene in &scenes {
             for set in &scene.ray_sets {
@@ -155,4 +170,109 @@ fn main() -> Result<(), Error> {
         }
     }
     Ok(())
+}
+
+/// `--split`: ours and Embree on the rays ours misses and the rays it hits, apart.
+#[cfg(feature = "embree")]
+mod split {
+    use host::rayfile::RayRecord;
+    use host::trace::{build_and_visit, trace_closest_per_ray, AccelConfig, NodeArena};
+    use raykernel::bvh::BuildOptions;
+    use raykernel::{Accel, AccelKind, AccelVisitor};
+    use raykernel_bench::embree::{flat_records, Device, Geometry, Scene, Settings};
+    use raykernel_bench::error::Error;
+    use raykernel_bench::ours::mrays;
+    use raykernel_bench::rounds::Pairing;
+    use raykernel_bench::workload::{BenchScene, RayKind, RaySet};
+
+    /// Builds both structures, splits `set` by our hits, and prints per part the median ns per
+    /// ray of each side and the per-round ratios ours ÷ Embree (speed: above 1, ours faster).
+    pub fn run(scene: &BenchScene, set: &RaySet, rounds: usize) -> Result<(), Error> {
+        let unavailable = || Error::Bench("Embree could not build the scene".to_string());
+        let device = Device::new().ok_or_else(unavailable)?;
+        let geometry = Geometry::of(&scene.mesh);
+        let (embree, _) =
+            Scene::build(&device, &geometry, Settings::HIGH).ok_or_else(unavailable)?;
+        let tris = scene.mesh.kernel_triangles::<f32>(&scene.path)?;
+        let accel = AccelKind::Bvh8(BuildOptions::DEFAULT);
+        let config = AccelConfig {
+            accel,
+            leaf_order: accel.permutes_into_leaf_order(),
+        };
+        let mut arena = NodeArena::<f32>::for_accel(accel, &tris);
+        let parts = Parts {
+            records: &set.records,
+            kind: set.kind,
+            embree: &embree,
+            rounds: rounds.max(1),
+        };
+        let (_, lines) = build_and_visit(&tris, &mut arena, &scene.path, &config, parts)?;
+        for line in lines {
+            println!("{:8} {:10} {line}", scene.name, set.kind.name());
+        }
+        Ok(())
+    }
+
+    struct Parts<'a, 'd> {
+        records: &'a [RayRecord],
+        kind: RayKind,
+        embree: &'a Scene<'d>,
+        rounds: usize,
+    }
+
+    impl AccelVisitor<f32> for Parts<'_, '_> {
+        type Output = Vec<String>;
+
+        fn visit<A: Accel<f32>>(self, accel: &A) -> Vec<String> {
+            let (hits, _) = trace_closest_per_ray(accel, self.records);
+            let (mut missed, mut hit) = (Vec::new(), Vec::new());
+            for (record, found) in self.records.iter().zip(&hits) {
+                if found.prim == u32::MAX {
+                    missed.push(*record);
+                } else {
+                    hit.push(*record);
+                }
+            }
+            [("misses", missed), ("hits", hit)]
+                .into_iter()
+                .map(|(name, records)| {
+                    let flat = flat_records(&records);
+                    let (mut ours, mut peer) = (Vec::new(), Vec::new());
+                    for _ in 0..self.rounds {
+                        let (_, ms) = trace_closest_per_ray(accel, &records);
+                        ours.push(mrays(records.len(), ms));
+                        let (_, ms) = self.embree.closest(&flat, self.kind);
+                        peer.push(mrays(records.len(), ms));
+                    }
+                    let ns = |mrays: f64| if mrays > 0.0 { 1e3 / mrays } else { 0.0 };
+                    match Pairing::of(&ours, &peer) {
+                        Some(p) if !records.is_empty() => {
+                            let (lo, hi) = p.ratio_range();
+                            format!(
+                                "{name:6} {:7} rays: ours {:6.1} ns, Embree HIGH {:6.1} ns, ours ÷ Embree per round {:.3} ({lo:.3}-{hi:.3})",
+                                records.len(),
+                                ns(p.ours_median),
+                                ns(p.peer_median),
+                                p.median_ratio()
+                            )
+                        }
+                        _ => format!("{name:6}       0 rays"),
+                    }
+                })
+                .collect()
+        }
+    }
+}
+
+/// `--split` needs Embree.
+#[cfg(not(feature = "embree"))]
+mod split {
+    use raykernel_bench::error::Error;
+    use raykernel_bench::workload::{BenchScene, RaySet};
+
+    pub fn run(_: &BenchScene, _: &RaySet, _: usize) -> Result<(), Error> {
+        Err(Error::Bench(
+            "--split compares with Embree: build with --features embree".to_string(),
+        ))
+    }
 }
