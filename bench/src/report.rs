@@ -1450,7 +1450,8 @@ fn notes_section(s: &mut String) {
          traversal): `cargo bench -p raykernel-bench --bench hot`.\n\
          - The interleaved rounds alone, with ray construction timed apart, for A/B work on the \
          headline structure (seconds per scene): `cargo run --release -p raykernel-bench \
-         --features embree --example rounds -- --rays RAYS_DIR`.\n",
+         --features embree --example rounds -- --rays RAYS_DIR`; with `--split`, the rays ours \
+         misses and those it hits timed apart against Embree HIGH.\n",
         huge_page_mode()
     );
 }
