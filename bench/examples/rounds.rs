@@ -177,12 +177,11 @@ fn main() -> Result<(), Error> {
 mod split {
     use host::rayfile::RayRecord;
     use host::trace::{build_and_visit, trace_closest_per_ray, AccelConfig, NodeArena};
-    use raykernel::bvh::BuildOptions;
-    use raykernel::{Accel, AccelKind, AccelVisitor};
+    use raykernel::{Accel, AccelVisitor};
     use raykernel_bench::embree::{flat_records, Device, Geometry, Scene, Settings};
     use raykernel_bench::error::Error;
     use raykernel_bench::ours::mrays;
-    use raykernel_bench::rounds::Pairing;
+    use raykernel_bench::rounds::{Pairing, STRUCTURES};
     use raykernel_bench::workload::{BenchScene, RayKind, RaySet};
 
     /// Builds both structures, splits `set` by our hits, and prints per part the median ns per
@@ -194,7 +193,7 @@ mod split {
         let (embree, _) =
             Scene::build(&device, &geometry, Settings::HIGH).ok_or_else(unavailable)?;
         let tris = scene.mesh.kernel_triangles::<f32>(&scene.path)?;
-        let accel = AccelKind::Bvh8(BuildOptions::DEFAULT);
+        let [_, accel] = STRUCTURES; // the 8-wide BVH
         let config = AccelConfig {
             accel,
             leaf_order: accel.permutes_into_leaf_order(),
