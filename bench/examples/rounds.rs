@@ -113,7 +113,7 @@ fn main() -> Result<(), Error> {
     if args.split {
         for scene in &scenes {
             for set in &scene.ray_sets {
-                split::run(scene, set, args.rounds)?;
+                split(scene, set, args.rounds)?;
             }
         }
         return Ok(());
@@ -172,106 +172,37 @@ fn main() -> Result<(), Error> {
     Ok(())
 }
 
-/// `--split`: ours and Embree on the rays ours misses and the rays it hits, apart.
-#[cfg(feature = "embree")]
-mod split {
-    use host::rayfile::RayRecord;
-    use host::trace::{build_and_visit, trace_closest_per_ray, AccelConfig, NodeArena};
-    use raykernel::{Accel, AccelVisitor};
-    use raykernel_bench::embree::{flat_records, Device, Geometry, Scene, Settings};
-    use raykernel_bench::error::Error;
-    use raykernel_bench::ours::mrays;
-    use raykernel_bench::rounds::{Pairing, STRUCTURES};
-    use raykernel_bench::workload::{BenchScene, RayKind, RaySet};
-
-    /// Builds both structures, splits `set` by our hits, and prints per part the median ns per
-    /// ray of each side and the per-round ratios ours ÷ Embree (speed: above 1, ours faster).
-    pub fn run(scene: &BenchScene, set: &RaySet, rounds: usize) -> Result<(), Error> {
-        let unavailable = || Error::Bench("Embree could not build the scene".to_string());
-        let device = Device::new().ok_or_else(unavailable)?;
-        let geometry = Geometry::of(&scene.mesh);
-        let (embree, _) =
-            Scene::build(&device, &geometry, Settings::HIGH).ok_or_else(unavailable)?;
-        let tris = scene.mesh.kernel_triangles::<f32>(&scene.path)?;
-        let [_, accel] = STRUCTURES; // the 8-wide BVH
-        let config = AccelConfig {
-            accel,
-            leaf_order: accel.permutes_into_leaf_order(),
-        };
-        let mut arena = NodeArena::<f32>::for_accel(accel, &tris);
-        let parts = Parts {
-            records: &set.records,
-            kind: set.kind,
-            embree: &embree,
-            rounds: rounds.max(1),
-        };
-        let (_, lines) = build_and_visit(&tris, &mut arena, &scene.path, &config, parts)?;
-        for line in lines {
-            println!("{:8} {:10} {line}", scene.name, set.kind.name());
-        }
-        Ok(())
-    }
-
-    struct Parts<'a, 'd> {
-        records: &'a [RayRecord],
-        kind: RayKind,
-        embree: &'a Scene<'d>,
-        rounds: usize,
-    }
-
-    impl AccelVisitor<f32> for Parts<'_, '_> {
-        type Output = Vec<String>;
-
-        fn visit<A: Accel<f32>>(self, accel: &A) -> Vec<String> {
-            let (hits, _) = trace_closest_per_ray(accel, self.records);
-            let (mut missed, mut hit) = (Vec::new(), Vec::new());
-            for (record, found) in self.records.iter().zip(&hits) {
-                if found.prim == u32::MAX {
-                    missed.push(*record);
-                } else {
-                    hit.push(*record);
-                }
-            }
-            [("misses", missed), ("hits", hit)]
-                .into_iter()
-                .map(|(name, records)| {
-                    let flat = flat_records(&records);
-                    let (mut ours, mut peer) = (Vec::new(), Vec::new());
-                    for _ in 0..self.rounds {
-                        let (_, ms) = trace_closest_per_ray(accel, &records);
-                        ours.push(mrays(records.len(), ms));
-                        let (_, ms) = self.embree.closest(&flat, self.kind);
-                        peer.push(mrays(records.len(), ms));
-                    }
-                    let ns = |mrays: f64| if mrays > 0.0 { 1e3 / mrays } else { 0.0 };
-                    match Pairing::of(&ours, &peer) {
-                        Some(p) if !records.is_empty() => {
-                            let (lo, hi) = p.ratio_range();
-                            format!(
-                                "{name:6} {:7} rays: ours {:6.1} ns, Embree HIGH {:6.1} ns, ours ÷ Embree per round {:.3} ({lo:.3}-{hi:.3})",
-                                records.len(),
-                                ns(p.ours_median),
-                                ns(p.peer_median),
-                                p.median_ratio()
-                            )
-                        }
-                        _ => format!("{name:6}       0 rays"),
-                    }
-                })
-                .collect()
-        }
-    }
-}
-
-/// `--split` needs Embree.
-#[cfg(not(feature = "embree"))]
-mod split {
-    use raykernel_bench::error::Error;
-    use raykernel_bench::workload::{BenchScene, RaySet};
-
-    pub fn run(_: &BenchScene, _: &RaySet, _: usize) -> Result<(), Error> {
-        Err(Error::Bench(
+/// `--split`: per part of the ray set ([`rounds::split`]), the median ns per ray of ours and of
+/// Embree HIGH, and the per-round ratios ours ÷ Embree (speed: above 1, ours faster).
+fn split(scene: &BenchScene, set: &RaySet, rounds: usize) -> Result<(), Error> {
+    let Some(parts) = rounds::split(scene, set, rounds)? else {
+        return Err(Error::Bench(
             "--split compares with Embree: build with --features embree".to_string(),
-        ))
+        ));
+    };
+    let ns = |mrays: f64| if mrays > 0.0 { 1e3 / mrays } else { 0.0 };
+    for part in parts {
+        if part.rays == 0 {
+            println!(
+                "{:8} {:10} {:6}       0 rays",
+                scene.name,
+                set.kind.name(),
+                part.name
+            );
+            continue;
+        }
+        let p = &part.vs_embree;
+        let (lo, hi) = p.ratio_range();
+        println!(
+            "{:8} {:10} {:6} {:7} rays: ours {:6.1} ns, Embree HIGH {:6.1} ns, ours ÷ Embree per round {:.3} ({lo:.3}-{hi:.3})",
+            scene.name,
+            set.kind.name(),
+            part.name,
+            part.rays,
+            ns(p.ours_median),
+            ns(p.peer_median),
+            p.median_ratio()
+        );
     }
+    Ok(())
 }

@@ -18,7 +18,7 @@
 use crate::error::Error;
 use crate::ours::mrays;
 use crate::workload::{BenchScene, RayKind, RaySet};
-use host::rayfile::RayRecord;
+use host::rayfile::{HitRecord, RayRecord};
 use host::trace::{
     build_and_visit, median, prepare_rays, trace_closest, trace_closest_per_ray, AccelConfig,
     NodeArena, PreparedRays,
@@ -276,9 +276,14 @@ impl Alternate<'_> {
     fn run<A: Accel<f32>, B: Accel<f32>>(self, first: &A, second: &B) -> Figures {
         let n = self.prepared.rays.len();
         let mut figures = Figures::default();
-        let inputs = EmbreeInputs::new(self.scene, self.set, self.with_peers);
+        let inputs = EmbreeInputs::new(self.scene, self.set.kind, self.with_peers);
         let embree = inputs.build(false);
         let embree_robust = inputs.build(true);
+        let flat = if embree.is_some() {
+            EmbreeInputs::flatten(&self.set.records)
+        } else {
+            Vec::new()
+        };
         let coherent = Coherent(second);
         let round = |figures: &mut Figures| {
             let [per_ray_a, per_ray_b, per_ray_c] = &mut figures.per_ray;
@@ -289,10 +294,10 @@ impl Alternate<'_> {
                 trace_closest_per_ray(&coherent, &self.set.records).1,
             ));
             if let Some(e) = &embree {
-                figures.embree.push(e.trace());
+                figures.embree.push(e.trace(&flat));
             }
             if let Some(e) = &embree_robust {
-                figures.embree_robust.push(e.trace());
+                figures.embree_robust.push(e.trace(&flat));
             }
             let [prebuilt_a, prebuilt_b, prebuilt_c] = &mut figures.prebuilt;
             prebuilt_a.push(mrays(n, trace_closest(first, self.prepared).1));
@@ -321,30 +326,25 @@ impl Alternate<'_> {
     }
 }
 
-/// Embree HIGH for the rounds, with the `embree` feature: a device, the scene's geometry and
-/// flat records ([`EmbreeInputs::new`]), and a scene built once over them in Embree's default
-/// mode and once in its robust mode ([`EmbreeInputs::build`]). Without the feature, nothing.
+/// Embree HIGH for the rounds, with the `embree` feature: a device and the scene's geometry
+/// ([`EmbreeInputs::new`]), and a scene built over them in Embree's default mode or its robust
+/// mode ([`EmbreeInputs::build`]), which traces records flattened by
+/// [`EmbreeInputs::flatten`]. Without the feature, nothing.
 #[cfg(feature = "embree")]
 struct EmbreeInputs {
     device: Option<crate::embree::Device>,
     geometry: crate::embree::Geometry,
-    flat: Vec<f32>,
     kind: RayKind,
 }
 
 #[cfg(feature = "embree")]
 impl EmbreeInputs {
-    fn new(scene: &BenchScene, set: &RaySet, wanted: bool) -> Self {
-        use crate::embree::{flat_records, Device, Geometry};
+    fn new(scene: &BenchScene, kind: RayKind, wanted: bool) -> Self {
+        use crate::embree::{Device, Geometry};
         Self {
             device: if wanted { Device::new() } else { None },
             geometry: Geometry::of(&scene.mesh),
-            flat: if wanted {
-                flat_records(&set.records)
-            } else {
-                Vec::new()
-            },
-            kind: set.kind,
+            kind,
         }
     }
 
@@ -360,23 +360,27 @@ impl EmbreeInputs {
         let (scene, _) = Scene::build(device, &self.geometry, settings)?;
         Some(EmbreeTracer {
             scene,
-            flat: &self.flat,
             kind: self.kind,
         })
+    }
+
+    /// `records` as [`EmbreeTracer::trace`] takes them.
+    fn flatten(records: &[RayRecord]) -> Vec<f32> {
+        crate::embree::flat_records(records)
     }
 }
 
 #[cfg(feature = "embree")]
 struct EmbreeTracer<'a> {
     scene: crate::embree::Scene<'a>,
-    flat: &'a [f32],
     kind: RayKind,
 }
 
 #[cfg(feature = "embree")]
 impl EmbreeTracer<'_> {
-    fn trace(&self) -> f64 {
-        let (hits, ms) = self.scene.closest(self.flat, self.kind);
+    /// Mrays/s of one pass over `flat` ([`EmbreeInputs::flatten`]).
+    fn trace(&self, flat: &[f32]) -> f64 {
+        let (hits, ms) = self.scene.closest(flat, self.kind);
         mrays(hits.len(), ms)
     }
 }
@@ -386,12 +390,16 @@ struct EmbreeInputs;
 
 #[cfg(not(feature = "embree"))]
 impl EmbreeInputs {
-    fn new(_: &BenchScene, _: &RaySet, _: bool) -> Self {
+    fn new(_: &BenchScene, _: RayKind, _: bool) -> Self {
         Self
     }
 
     fn build(&self, _robust: bool) -> Option<EmbreeTracer> {
         None
+    }
+
+    fn flatten(_: &[RayRecord]) -> Vec<f32> {
+        Vec::new()
     }
 }
 
@@ -400,7 +408,85 @@ struct EmbreeTracer;
 
 #[cfg(not(feature = "embree"))]
 impl EmbreeTracer {
-    fn trace(&self) -> f64 {
+    fn trace(&self, _: &[f32]) -> f64 {
         0.0
+    }
+}
+
+/// One part of a ray set in [`split`]: its rays, and ours per ray against Embree HIGH.
+#[derive(Clone, Debug)]
+pub struct SplitPart {
+    /// `misses` or `hits` (of ours).
+    pub name: &'static str,
+    /// Rays in the part.
+    pub rays: usize,
+    /// Mrays/s of the 8-wide BVH per ray and of Embree HIGH, round by round.
+    pub vs_embree: Pairing,
+}
+
+/// The ray set split into the rays the 8-wide BVH of [`STRUCTURES`] misses and those it hits,
+/// each part traced `rounds` times in alternation by that BVH (per ray, its default walk) and
+/// by Embree HIGH: whether a gap lies in what every ray pays (setup, the top nodes) or in the
+/// descent to a hit and the triangle tests. `None` without Embree in this build.
+///
+/// # Errors
+/// A build the kernel refuses.
+pub fn split(
+    scene: &BenchScene,
+    set: &RaySet,
+    rounds: usize,
+) -> Result<Option<Vec<SplitPart>>, Error> {
+    let tris = scene.mesh.kernel_triangles::<f32>(&scene.path)?;
+    let [_, accel] = STRUCTURES;
+    let mut arena = NodeArena::<f32>::for_accel(accel, &tris);
+    let parts = Split {
+        scene,
+        set,
+        rounds: rounds.max(1),
+    };
+    let (_, parts) = build_and_visit(&tris, &mut arena, &scene.path, &config(accel), parts)?;
+    Ok(parts)
+}
+
+/// Visits the built 8-wide BVH: the rounds of [`split`].
+struct Split<'p> {
+    scene: &'p BenchScene,
+    set: &'p RaySet,
+    rounds: usize,
+}
+
+impl AccelVisitor<f32> for Split<'_> {
+    type Output = Option<Vec<SplitPart>>;
+
+    fn visit<A: Accel<f32>>(self, accel: &A) -> Self::Output {
+        let inputs = EmbreeInputs::new(self.scene, self.set.kind, true);
+        let embree = inputs.build(false)?;
+        let (hits, _) = trace_closest_per_ray(accel, &self.set.records);
+        let (missed, hit): (Vec<_>, Vec<_>) = self
+            .set
+            .records
+            .iter()
+            .zip(&hits)
+            .partition(|(_, found)| found.prim == HitRecord::MISS.prim);
+        let part = |name, pairs: Vec<(&RayRecord, &HitRecord)>| {
+            let records: Vec<RayRecord> = pairs.into_iter().map(|(r, _)| *r).collect();
+            let flat = EmbreeInputs::flatten(&records);
+            let (mut ours, mut peer) = (Vec::new(), Vec::new());
+            for _ in 0..self.rounds {
+                ours.push(mrays(
+                    records.len(),
+                    trace_closest_per_ray(accel, &records).1,
+                ));
+                peer.push(embree.trace(&flat));
+            }
+            Pairing::of(&ours, &peer).map(|vs_embree| SplitPart {
+                name,
+                rays: records.len(),
+                vs_embree,
+            })
+        };
+        [part("misses", missed), part("hits", hit)]
+            .into_iter()
+            .collect()
     }
 }
