@@ -1429,7 +1429,9 @@ fn notes_section(s: &mut String) {
          distance. Its build time and bytes per triangle here are MEDIUM's, not HIGH's: in \
          robust mode Embree builds without HIGH's spatial splits, whatever quality is asked \
          for.\n\
-         - Peers' triangle tests: Embree its own; obvhs its own two-sided Möller–Trumbore; \
+         - Peers' triangle tests: Embree its own (Möller–Trumbore over blocks of four \
+         triangles, Plücker in robust mode), in the kernels its CPU detection selects (its \
+         AVX-512 ones on a CPU that has AVX-512); obvhs its own two-sided Möller–Trumbore; \
          bvh's `intersects_triangle` culls back faces, so its rows use this benchmark's \
          two-sided Möller–Trumbore and its `nearest_traverse_iterator` (boxes in order of \
          entry, stopped past the best hit); tinybvh traces with its scalar `BVH::Intersect` and \
