@@ -5,7 +5,8 @@
 //! per-round ratios against both Embree modes. Seconds per scene instead of the full
 //! benchmark's quarter hour; the full run stays the one that writes the report.
 //! `--simd-ab` compares the traversal's two compiled copies instead (`raykernel::cpu`);
-//! `--split` times the rays that miss and the rays that hit apart, ours against Embree HIGH.
+//! `--split` times the rays that miss and the rays that hit apart, ours against Embree HIGH, and
+//! counts the boxes and triangles ours tests per ray in each part.
 //!
 //! ```text
 //! python3 ../shared/bench/make_rays.py --out /tmp/rays bunny sponza kitchen
@@ -45,8 +46,9 @@ struct Args {
     simd_ab: bool,
     /// Instead of the rounds: each ray set split into the rays ours misses and the rays it hits,
     /// and per round the 8-wide BVH's default walk (per ray) and Embree HIGH on each part
-    /// (needs the `embree` feature). Shows whether a gap lies in what every ray pays (setup,
-    /// the top nodes) or in the descent to a hit and the triangle tests.
+    /// (needs the `embree` feature), with the boxes and triangles ours tests per ray in each
+    /// part. Shows whether a gap lies in what every ray pays (setup, the top nodes) or in the
+    /// descent to a hit and the triangle tests.
     #[arg(long)]
     split: bool,
 }
@@ -193,15 +195,18 @@ fn split(scene: &BenchScene, set: &RaySet, rounds: usize) -> Result<(), Error> {
         }
         let p = &part.vs_embree;
         let (lo, hi) = p.ratio_range();
+        let per_ray = |n: u64| n as f64 / part.rays as f64;
         println!(
-            "{:8} {:10} {:6} {:7} rays: ours {:6.1} ns, Embree HIGH {:6.1} ns, ours ÷ Embree per round {:.3} ({lo:.3}-{hi:.3})",
+            "{:8} {:10} {:6} {:7} rays: ours {:6.1} ns, Embree HIGH {:6.1} ns, ours ÷ Embree per round {:.3} ({lo:.3}-{hi:.3}); ours per ray {:.1} boxes, {:.2} triangles",
             scene.name,
             set.kind.name(),
             part.name,
             part.rays,
             ns(p.ours_median),
             ns(p.peer_median),
-            p.median_ratio()
+            p.median_ratio(),
+            per_ray(part.counted.nodes_visited),
+            per_ray(part.counted.prims_tested)
         );
     }
     Ok(())

@@ -1453,7 +1453,8 @@ fn notes_section(s: &mut String) {
          - The interleaved rounds alone, with ray construction timed apart, for A/B work on the \
          headline structure (seconds per scene): `cargo run --release -p raykernel-bench \
          --features embree --example rounds -- --rays RAYS_DIR`; with `--split`, the rays ours \
-         misses and those it hits timed apart against Embree HIGH.\n",
+         misses and those it hits timed apart against Embree HIGH, with the boxes and \
+         triangles ours tests per ray in each.\n",
         huge_page_mode()
     );
 }

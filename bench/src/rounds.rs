@@ -24,8 +24,9 @@ use host::trace::{
     NodeArena, PreparedRays,
 };
 use raykernel::bvh::BuildOptions;
-use raykernel::{Accel, AccelKind, AccelVisitor, Coherent, Triangle};
+use raykernel::{Accel, AccelKind, AccelVisitor, Coherent, Ray, TraversalStats, Triangle};
 use serde::Serialize;
+use std::hint::black_box;
 
 /// The structures of the rounds, in this order: the wide BVHs from the SAH build.
 pub const STRUCTURES: [AccelKind; 2] = [
@@ -422,6 +423,9 @@ pub struct SplitPart {
     pub rays: usize,
     /// Mrays/s of the 8-wide BVH per ray and of Embree HIGH, round by round.
     pub vs_embree: Pairing,
+    /// The 8-wide BVH's work over the part's rays (boxes and primitives tested), counted in a
+    /// pass of its own, untimed.
+    pub counted: TraversalStats,
 }
 
 /// The ray set split into the rays the 8-wide BVH of [`STRUCTURES`] misses and those it hits,
@@ -479,10 +483,17 @@ impl AccelVisitor<f32> for Split<'_> {
                 ));
                 peer.push(embree.trace(&flat));
             }
+            let mut counted = TraversalStats::default();
+            for r in &records {
+                if let Ok(ray) = Ray::<f32>::from_f32(r.origin, r.dir, r.t_min, r.t_max) {
+                    black_box(accel.nearest_counted(&ray, &mut counted));
+                }
+            }
             Pairing::of(&ours, &peer).map(|vs_embree| SplitPart {
                 name,
                 rays: records.len(),
                 vs_embree,
+                counted,
             })
         };
         [part("misses", missed), part("hits", hit)]
