@@ -14,7 +14,8 @@ use host::trace::{
 };
 use raykernel::bvh::{BuildOptions, BuilderKind};
 use raykernel::{
-    Accel, AccelKind, AccelVisitor, Coherent, Primitive, Scalar, TraversalStats, Triangle, I16F16,
+    Accel, AccelKind, AccelVisitor, Coherent, Primitive, Ray, Scalar, TraversalStats, Triangle,
+    I16F16,
 };
 use std::hint::black_box;
 use std::path::Path;
@@ -236,6 +237,17 @@ pub fn warm_up(scene: &BenchScene, set: &RaySet) -> Result<(), Error> {
     measure(&tris32, &prepared, &rays, &config).map(|_| ())
 }
 
+/// The work (boxes and primitives tested) of a closest-hit pass of `accel` over `rays`,
+/// untimed.
+#[must_use]
+pub fn count_work<S: Scalar, A: Accel<S>>(accel: &A, rays: &[Ray<S>]) -> TraversalStats {
+    let mut counted = TraversalStats::default();
+    for ray in rays {
+        black_box(accel.intersect_counted(ray, &mut counted));
+    }
+    counted
+}
+
 /// Million rays per second.
 #[must_use]
 pub fn mrays(rays: usize, ms: f64) -> f64 {
@@ -378,11 +390,7 @@ impl<S: Scalar> Pass<'_, S> {
                 out.any_hits -= 1;
             }
         }
-        let mut counted = TraversalStats::default();
-        for ray in rays {
-            black_box(accel.intersect_counted(ray, &mut counted));
-        }
-        out.counted = counted;
+        out.counted = count_work(accel, rays);
         out
     }
 }

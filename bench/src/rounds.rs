@@ -16,7 +16,7 @@
 //! noisy environments").
 
 use crate::error::Error;
-use crate::ours::mrays;
+use crate::ours::{count_work, mrays};
 use crate::workload::{BenchScene, RayKind, RaySet};
 use host::rayfile::{HitRecord, RayRecord};
 use host::trace::{
@@ -24,9 +24,8 @@ use host::trace::{
     NodeArena, PreparedRays,
 };
 use raykernel::bvh::BuildOptions;
-use raykernel::{Accel, AccelKind, AccelVisitor, Coherent, Ray, TraversalStats, Triangle};
+use raykernel::{Accel, AccelKind, AccelVisitor, Coherent, TraversalStats, Triangle};
 use serde::Serialize;
-use std::hint::black_box;
 
 /// The structures of the rounds, in this order: the wide BVHs from the SAH build.
 pub const STRUCTURES: [AccelKind; 2] = [
@@ -483,12 +482,7 @@ impl AccelVisitor<f32> for Split<'_> {
                 ));
                 peer.push(embree.trace(&flat));
             }
-            let mut counted = TraversalStats::default();
-            for r in &records {
-                if let Ok(ray) = Ray::<f32>::from_f32(r.origin, r.dir, r.t_min, r.t_max) {
-                    black_box(accel.nearest_counted(&ray, &mut counted));
-                }
-            }
+            let counted = count_work(accel, &prepare_rays::<f32>(&records).rays);
             Pairing::of(&ours, &peer).map(|vs_embree| SplitPart {
                 name,
                 rays: records.len(),

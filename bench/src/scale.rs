@@ -10,7 +10,7 @@
 //! count. Rays: primary from that camera, incoherent from SplitMix64 in the scene box.
 
 use crate::error::Error;
-use crate::ours::mrays;
+use crate::ours::{count_work, mrays};
 use crate::results::ScaleRow;
 use crate::workload::{incoherent_rays, primary_rays, side_for};
 use host::obj::Mesh;
@@ -22,7 +22,6 @@ use host::trace::{
 use raykernel::bvh::BuildOptions;
 use raykernel::{Accel, AccelKind, AccelVisitor, Scalar, TraversalStats, I16F16};
 use raykernel_testkit::Rng;
-use std::hint::black_box;
 use std::path::Path;
 
 const CELL: f64 = 10.0;
@@ -265,12 +264,11 @@ impl<S: Scalar> AccelVisitor<S> for TwoSets<'_, S> {
     fn visit<A: Accel<S>>(self, accel: &A) -> Self::Output {
         let (_, ms_a) = trace_closest(accel, self.a);
         let (_, ms_b) = trace_closest(accel, self.b);
-        let mut stats = TraversalStats::default();
-        if self.count {
-            for ray in &self.b.rays {
-                black_box(accel.intersect_counted(ray, &mut stats));
-            }
-        }
+        let stats = if self.count {
+            count_work(accel, &self.b.rays)
+        } else {
+            TraversalStats::default()
+        };
         (ms_a, ms_b, stats)
     }
 }
