@@ -56,8 +56,8 @@ pub struct BenchArgs {
     #[arg(long)]
     pub no_peers: bool,
     /// Interleaved rounds per ray set: the headline contender, Embree HIGH (with the `embree`
-    /// feature) and tinybvh's BVH2 (with the `tinybvh` feature) traced in alternation; `0`
-    /// skips them [default: 7, or 2 with --quick].
+    /// feature) and tinybvh's BVH2 and 8-wide BVH (with the `tinybvh` feature) traced in
+    /// alternation; `0` skips them [default: 7, or 2 with --quick].
     #[arg(long, value_name = "N")]
     pub rounds: Option<usize>,
     /// Tiled-scene sizes in triangles, comma-separated; `0` skips the sweep

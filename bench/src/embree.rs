@@ -17,7 +17,8 @@
 //! than alone. So every call into Embree is followed, outside its timing, by
 //! [`clear_upper_vector_state`], as compiled AVX code does before it returns to SSE code.
 //!
-//! The only `unsafe` code of the benchmark is here: the foreign calls, and the `vzeroupper`.
+//! The benchmark's `unsafe` code is here (the foreign calls, and the `vzeroupper`) and in
+//! `tinybvh8` (its foreign calls).
 #![allow(unsafe_code)]
 
 use crate::workload::RayKind;

@@ -85,10 +85,22 @@ pub fn figures(r: &BenchResults) -> Vec<Figure> {
                 &x.tinybvh_mrays,
             ),
         ];
-        for (contender, figure, values) in ours.chain(peers) {
+        let tinybvh8 = crate::rounds::TINYBVH8_BUILDS
+            .iter()
+            .zip(&x.tinybvh8_mrays)
+            .map(|(name, values)| (name.to_string(), "closest_mrays_prebuilt", values));
+        for (contender, figure, values) in ours.chain(peers).chain(tinybvh8) {
             for (k, v) in values.iter().enumerate() {
                 let name = format!("{figure}_{}{}", names::ROUND_PREFIX, k + 1);
                 push(&x.scene, x.rays.name(), &contender, &name, *v);
+            }
+        }
+        for (name, pct) in crate::rounds::TINYBVH8_BUILDS
+            .iter()
+            .zip(x.tinybvh8_same_pct)
+        {
+            if let Some(pct) = pct {
+                push(&x.scene, x.rays.name(), name, "same_prim_pct_vs_ours", pct);
             }
         }
     }

@@ -10,7 +10,7 @@
 //! - [`peers`]: Embree 3 (HIGH and MEDIUM, `embree` feature, through [`embree`]), tinybvh
 //!   (`tinybvh` feature), `obvhs` (BVH2, CWBVH) and `bvh`, measured in the same run,
 //! - [`rounds`]: the headline contender, Embree and tinybvh traced in alternation, round by
-//!   round,
+//!   round (tinybvh's 8-wide BVH through `tinybvh8`, `tinybvh` feature),
 //! - [`accuracy`]: the `f64` reference and each contender's hit-distance error,
 //! - [`scale`]: the tiled scene from 10k to 1M+ triangles,
 //! - [`refit`]: refitting the trees after the mesh moved, against rebuilding them,
@@ -47,6 +47,8 @@ pub mod results;
 pub mod rounds;
 pub mod scale;
 pub mod stats;
+#[cfg(feature = "tinybvh")]
+pub mod tinybvh8;
 pub mod workload;
 
 use crate::error::Error;

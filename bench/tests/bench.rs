@@ -213,6 +213,19 @@ fn bench_writes_a_well_formed_report_csv_json_and_plots() {
                         assert!(figure(rows, scene, rays, embree, &name) > 0.0, "{embree}");
                     }
                 }
+                if cfg!(feature = "tinybvh") {
+                    let name = format!("closest_mrays_prebuilt_round{k}");
+                    for tiny in ["tinybvh 1.6 BVH8", "tinybvh 1.6 BVH8 HQ"] {
+                        assert!(figure(rows, scene, rays, tiny, &name) > 0.0, "{tiny}");
+                    }
+                }
+            }
+            // tinybvh's 8-wide BVH finds ours' triangles (not watertight: a few may differ).
+            if cfg!(feature = "tinybvh") {
+                for tiny in ["tinybvh 1.6 BVH8", "tinybvh 1.6 BVH8 HQ"] {
+                    let same = figure(rows, scene, rays, tiny, "same_prim_pct_vs_ours");
+                    assert!(same > 99.0, "{tiny}: {same}% of hits as ours");
+                }
             }
         }
     }
