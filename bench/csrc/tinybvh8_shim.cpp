@@ -71,10 +71,5 @@ void rkb_tiny8_trace(void* p, float* t_out, uint32_t* prim_out) {
     }
 }
 
-// Bytes of the traversal data (nodes and leaf blocks).
-size_t rkb_tiny8_bytes(const void* p) {
-    return static_cast<size_t>(static_cast<const Tiny8*>(p)->bvh.usedBlocks) * 64;
-}
-
 void rkb_tiny8_free(void* p) { delete static_cast<Tiny8*>(p); }
 }

@@ -30,7 +30,6 @@ mod ffi {
             count: u32,
         );
         pub fn rkb_tiny8_trace(bvh: *mut c_void, t_out: *mut f32, prim_out: *mut u32);
-        pub fn rkb_tiny8_bytes(bvh: *const c_void) -> usize;
         pub fn rkb_tiny8_free(bvh: *mut c_void);
     }
 }
@@ -125,13 +124,6 @@ impl TinyBvh8 {
                 }
             })
             .collect()
-    }
-
-    /// Bytes of its nodes and leaf blocks (which hold the triangles' data).
-    #[must_use]
-    pub fn bytes(&self) -> usize {
-        // SAFETY: the BVH is live.
-        unsafe { ffi::rkb_tiny8_bytes(self.raw.as_ptr()) }
     }
 }
 
