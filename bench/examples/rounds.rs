@@ -169,17 +169,18 @@ fn main() -> Result<(), Error> {
                     ours.structure,
                 );
             }
-            for (i, name) in rounds::TINYBVH8_BUILDS.iter().enumerate() {
-                if let Some(p) = row.tinybvh8_vs_embree(i) {
+            for t in &row.tinybvh8 {
+                if let Some(p) = row.vs_embree_of(t) {
                     let (lo, hi) = p.ratio_range();
                     println!(
-                        "{:8} {:10} {name:19} pre-built {:5.2}  Embree {:5.2}  ÷ Embree per round {:.3} ({lo:.3}-{hi:.3}); same hit triangle as ours {:.3}%",
+                        "{:8} {:10} {:19} pre-built {:5.2}  Embree {:5.2}  ÷ Embree per round {:.3} ({lo:.3}-{hi:.3}); same hit triangle as ours {:.3}%",
                         scene.name,
                         set.kind.name(),
+                        t.name,
                         p.ours_median,
                         p.peer_median,
                         p.median_ratio(),
-                        row.tinybvh8_same_pct[i].unwrap_or(0.0)
+                        t.same_prim_pct
                     );
                 }
             }

@@ -85,23 +85,24 @@ pub fn figures(r: &BenchResults) -> Vec<Figure> {
                 &x.tinybvh_mrays,
             ),
         ];
-        let tinybvh8 = crate::rounds::TINYBVH8_BUILDS
+        let tinybvh8 = x
+            .tinybvh8
             .iter()
-            .zip(&x.tinybvh8_mrays)
-            .map(|(name, values)| (name.to_string(), "closest_mrays_prebuilt", values));
+            .map(|t| (t.name.to_string(), "closest_mrays_prebuilt", &t.mrays));
         for (contender, figure, values) in ours.chain(peers).chain(tinybvh8) {
             for (k, v) in values.iter().enumerate() {
                 let name = format!("{figure}_{}{}", names::ROUND_PREFIX, k + 1);
                 push(&x.scene, x.rays.name(), &contender, &name, *v);
             }
         }
-        for (name, pct) in crate::rounds::TINYBVH8_BUILDS
-            .iter()
-            .zip(x.tinybvh8_same_pct)
-        {
-            if let Some(pct) = pct {
-                push(&x.scene, x.rays.name(), name, "same_prim_pct_vs_ours", pct);
-            }
+        for t in &x.tinybvh8 {
+            push(
+                &x.scene,
+                x.rays.name(),
+                t.name,
+                "same_prim_pct_vs_ours",
+                t.same_prim_pct,
+            );
         }
     }
     for x in &r.reference {

@@ -12,7 +12,7 @@ use crate::overhead::OverheadRow;
 use crate::plot::{grouped_bars, loglog, Series};
 use crate::refit::RefitRow;
 use crate::results::{ScaleRow, TraceRow};
-use crate::rounds::{Pairing, RoundsRow, TINYBVH8_BUILDS};
+use crate::rounds::{Pairing, PrebuiltPeer, RoundsRow};
 use crate::workload::RayKind;
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -705,21 +705,21 @@ fn rounds_section(s: &mut String, r: &BenchResults) {
             } else {
                 ""
             };
-            // tinybvh's 8-wide BVH against the headline only.
-            let headline = fastest == Some(ours.structure);
-            let pairs = [
-                ("per ray ÷ Embree 3 HIGH", x.vs_embree(ours)),
-                ("per ray ÷ Embree 3 HIGH robust", x.vs_embree_robust(ours)),
-                ("pre-built ÷ tinybvh BVH2", x.vs_tinybvh(ours)),
+            let mut pairs = vec![
+                ("per ray ÷ Embree 3 HIGH".to_string(), x.vs_embree(ours)),
                 (
-                    "pre-built ÷ tinybvh BVH8",
-                    x.vs_tinybvh8(ours, 0).filter(|_| headline),
+                    "per ray ÷ Embree 3 HIGH robust".to_string(),
+                    x.vs_embree_robust(ours),
                 ),
-                (
-                    "pre-built ÷ tinybvh BVH8 HQ",
-                    x.vs_tinybvh8(ours, 1).filter(|_| headline),
-                ),
+                ("pre-built ÷ tinybvh BVH2".to_string(), x.vs_tinybvh(ours)),
             ];
+            // tinybvh's 8-wide BVH against the headline only.
+            if fastest == Some(ours.structure) {
+                pairs.extend(x.tinybvh8.iter().map(|t| {
+                    let pairing = Pairing::of(&ours.prebuilt_mrays, &t.mrays);
+                    (format!("pre-built ÷ {}", t.name), pairing)
+                }));
+            }
             let mut any = false;
             for (name, pairing) in pairs {
                 let Some(p) = pairing else { continue };
@@ -758,11 +758,13 @@ fn rounds_section(s: &mut String, r: &BenchResults) {
 /// tinybvh's 8-wide BVH against Embree in the same rounds: the wide SIMD BVH the speed issue
 /// names as proof that Embree's figures can be reached, measured on this machine.
 fn tinybvh8_table(s: &mut String, r: &BenchResults) {
-    let rows: Vec<(&RoundsRow, usize, Pairing)> = r
+    let rows: Vec<(&RoundsRow, &PrebuiltPeer, Pairing)> = r
         .rounds
         .iter()
         .flat_map(|x| {
-            (0..TINYBVH8_BUILDS.len()).filter_map(move |i| Some((x, i, x.tinybvh8_vs_embree(i)?)))
+            x.tinybvh8
+                .iter()
+                .filter_map(move |t| Some((x, t, x.vs_embree_of(t)?)))
         })
         .collect();
     if rows.is_empty() {
@@ -778,20 +780,20 @@ fn tinybvh8_table(s: &mut String, r: &BenchResults) {
          | scene | rays | peer | peer median | peer best | Embree median | Embree best | peer ÷ Embree per round: median (min–max) | same |\n\
          |---|---|---|---:|---:|---:|---:|---:|---:|"
     );
-    for (x, i, p) in rows {
+    for (x, t, p) in rows {
         let (lo, hi) = p.ratio_range();
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2}× ({lo:.2}–{hi:.2}) | {} |",
+            "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2}× ({lo:.2}–{hi:.2}) | {:.3}% |",
             x.scene,
             x.rays.name(),
-            TINYBVH8_BUILDS[i],
+            t.name,
             p.ours_median,
             p.ours_best,
             p.peer_median,
             p.peer_best,
             p.median_ratio(),
-            x.tinybvh8_same_pct[i].map_or("-".into(), |pct| format!("{pct:.3}%")),
+            t.same_prim_pct,
         );
     }
     let _ = writeln!(s);

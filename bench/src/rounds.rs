@@ -66,17 +66,20 @@ pub struct RoundsRow {
     pub embree_robust_mrays: Vec<f64>,
     /// tinybvh's BVH2 on pre-built rays.
     pub tinybvh_mrays: Vec<f64>,
-    /// tinybvh's 8-wide CPU BVH on pre-built rays, one series per [`TINYBVH8_BUILDS`] (empty
-    /// without the `tinybvh` feature).
-    pub tinybvh8_mrays: [Vec<f64>; 2],
-    /// Per [`TINYBVH8_BUILDS`], the percentage of rays whose hit triangle (or miss) is the one
-    /// ours reports (`None` without it).
-    pub tinybvh8_same_pct: [Option<f64>; 2],
+    /// tinybvh's 8-wide CPU BVH, each build of it (none without the `tinybvh` feature).
+    pub tinybvh8: Vec<PrebuiltPeer>,
 }
 
-/// The builds of tinybvh's 8-wide BVH in the rounds, by the report's names: binned SAH, then
-/// spatial splits (`crate::tinybvh8::Build`).
-pub const TINYBVH8_BUILDS: [&str; 2] = ["tinybvh 1.6 BVH8", "tinybvh 1.6 BVH8 HQ"];
+/// A peer traced in the rounds on pre-built rays, with how often it agrees with ours.
+#[derive(Clone, Debug, Serialize)]
+pub struct PrebuiltPeer {
+    /// The report's name.
+    pub name: &'static str,
+    /// Mrays/s in each round.
+    pub mrays: Vec<f64>,
+    /// Percentage of rays whose hit triangle (or miss) is the one ours reports.
+    pub same_prim_pct: f64,
+}
 
 /// Median, fastest round, and per-round ratios of two series of figures.
 #[derive(Clone, Debug, PartialEq)]
@@ -160,18 +163,11 @@ impl RoundsRow {
         Pairing::of(&ours.prebuilt_mrays, &self.tinybvh_mrays)
     }
 
-    /// `ours` pre-built against build `i` of [`TINYBVH8_BUILDS`] (`None` without tinybvh).
+    /// `peer` (pre-built) against Embree HIGH per ray (`None` without Embree): how near the
+    /// issue's reference for a wide SIMD BVH comes to Embree.
     #[must_use]
-    pub fn vs_tinybvh8(&self, ours: &OursRounds, i: usize) -> Option<Pairing> {
-        Pairing::of(&ours.prebuilt_mrays, self.tinybvh8_mrays.get(i)?)
-    }
-
-    /// Build `i` of [`TINYBVH8_BUILDS`] on pre-built rays against Embree HIGH per ray (`None`
-    /// without either): how near the reference for a wide SIMD BVH comes to Embree.
-    #[must_use]
-    pub fn tinybvh8_vs_embree(&self, i: usize) -> Option<Pairing> {
-        let tiny = self.tinybvh8_mrays.get(i).filter(|t| !t.is_empty())?;
-        Pairing::of(tiny, &self.embree_mrays)
+    pub fn vs_embree_of(&self, peer: &PrebuiltPeer) -> Option<Pairing> {
+        Pairing::of(&peer.mrays, &self.embree_mrays)
     }
 }
 
@@ -237,8 +233,7 @@ pub fn run(
         embree_mrays: figures.embree,
         embree_robust_mrays: figures.embree_robust,
         tinybvh_mrays: figures.tinybvh,
-        tinybvh8_mrays: figures.tinybvh8,
-        tinybvh8_same_pct: figures.tinybvh8_same_pct,
+        tinybvh8: figures.tinybvh8,
     })
 }
 
@@ -296,8 +291,7 @@ struct Figures {
     embree: Vec<f64>,
     embree_robust: Vec<f64>,
     tinybvh: Vec<f64>,
-    tinybvh8: [Vec<f64>; 2],
-    tinybvh8_same_pct: [Option<f64>; 2],
+    tinybvh8: Vec<PrebuiltPeer>,
 }
 
 impl Alternate<'_> {
@@ -313,11 +307,14 @@ impl Alternate<'_> {
             Vec::new()
         };
         let coherent = Coherent(second);
-        let mut tinybvh8 = TinyBvh8Peers::new(self.scene, self.set, self.with_peers);
-        if tinybvh8.any() {
-            let ours = trace_closest_per_ray(second, &self.set.records).0;
-            figures.tinybvh8_same_pct = tinybvh8.same_pct(&ours);
-        }
+        // The triangles as tinybvh's peers take them (none without peers).
+        let tris: Vec<[[f32; 3]; 3]> = (0..self.scene.mesh.triangle_count())
+            .filter(|_| self.with_peers)
+            .map(|i| self.scene.mesh.triangle_f32(i))
+            .collect();
+        let mut tinybvh8 = TinyBvh8Peers::new(&tris, &self.set.records, || {
+            trace_closest_per_ray(second, &self.set.records).0
+        });
         let mut round = |figures: &mut Figures| {
             let [per_ray_a, per_ray_b, per_ray_c] = &mut figures.per_ray;
             per_ray_a.push(mrays(n, trace_closest_per_ray(first, &self.set.records).1));
@@ -336,12 +333,9 @@ impl Alternate<'_> {
             prebuilt_a.push(mrays(n, trace_closest(first, self.prepared).1));
             prebuilt_b.push(mrays(n, trace_closest(second, self.prepared).1));
             prebuilt_c.push(mrays(n, trace_closest(&coherent, self.prepared).1));
-            tinybvh8.round(&mut figures.tinybvh8);
+            tinybvh8.round();
         };
         let tinybvh = self.with_peers.then(|| {
-            let tris: Vec<[[f32; 3]; 3]> = (0..self.scene.mesh.triangle_count())
-                .map(|i| self.scene.mesh.triangle_f32(i))
-                .collect();
             let records: Vec<&RayRecord> = self.set.records.iter().collect();
             crate::peers::alternate_with_tinybvh(&tris, &records, self.rounds, &mut || {
                 round(&mut figures);
@@ -356,85 +350,72 @@ impl Alternate<'_> {
                 }
             }
         }
+        figures.tinybvh8 = tinybvh8.into_rows();
         figures
     }
 }
 
-/// tinybvh's 8-wide BVH for the rounds, one per [`TINYBVH8_BUILDS`], with the `tinybvh`
-/// feature; without it, none.
+/// tinybvh's 8-wide BVH for the rounds, each build of it, with the `tinybvh` feature; without
+/// it, none.
 struct TinyBvh8Peers {
     #[cfg(feature = "tinybvh")]
-    built: Vec<crate::tinybvh8::TinyBvh8>,
+    built: Vec<(crate::tinybvh8::TinyBvh8, PrebuiltPeer)>,
 }
 
 impl TinyBvh8Peers {
-    /// Both builds over the scene, their rays set from the set's records, when `with_peers`.
-    fn new(scene: &BenchScene, set: &RaySet, with_peers: bool) -> Self {
+    /// Every build over `tris` (none if empty), its rays set from `records`, each traced once
+    /// untimed against the hits `ours` gives (asked for only if something was built).
+    fn new(
+        tris: &[[[f32; 3]; 3]],
+        records: &[RayRecord],
+        ours: impl FnOnce() -> Vec<HitRecord>,
+    ) -> Self {
         #[cfg(feature = "tinybvh")]
         {
             use crate::tinybvh8::{Build, TinyBvh8};
-            let tris: Vec<[[f32; 3]; 3]> = if with_peers {
-                (0..scene.mesh.triangle_count())
-                    .map(|i| scene.mesh.triangle_f32(i))
-                    .collect()
-            } else {
-                Vec::new()
-            };
-            let built = Build::ALL
+            let peers: Vec<TinyBvh8> = Build::ALL
                 .iter()
-                .filter(|_| with_peers)
-                .filter_map(|&b| TinyBvh8::new(&tris, &set.records, b))
+                .filter(|_| !tris.is_empty())
+                .filter_map(|&b| TinyBvh8::new(tris, records, b))
+                .collect();
+            let ours = if peers.is_empty() { Vec::new() } else { ours() };
+            let built = peers
+                .into_iter()
+                .map(|mut peer| {
+                    peer.trace();
+                    let hits = peer.hits();
+                    let same = hits.iter().zip(&ours).filter(|(a, b)| a.prim == b.prim);
+                    let row = PrebuiltPeer {
+                        name: peer.build().name(),
+                        mrays: Vec::new(),
+                        same_prim_pct: 100.0 * same.count() as f64 / ours.len().max(1) as f64,
+                    };
+                    (peer, row)
+                })
                 .collect();
             Self { built }
         }
         #[cfg(not(feature = "tinybvh"))]
         {
-            let _ = (scene, set, with_peers);
+            let _ = (tris, records, ours);
             Self {}
         }
     }
 
-    /// True if any was built.
-    fn any(&self) -> bool {
-        #[cfg(feature = "tinybvh")]
-        return !self.built.is_empty();
-        #[cfg(not(feature = "tinybvh"))]
-        false
-    }
-
-    /// One untimed pass of each: the percentage of rays whose hit triangle (or miss) is the
-    /// one in `ours`, per build.
-    fn same_pct(&mut self, ours: &[HitRecord]) -> [Option<f64>; 2] {
-        #[cfg(feature = "tinybvh")]
-        {
-            let mut out = [None; 2];
-            for (peer, pct) in self.built.iter_mut().zip(&mut out) {
-                peer.trace();
-                let hits = peer.hits();
-                let same = hits
-                    .iter()
-                    .zip(ours)
-                    .filter(|(a, b)| a.prim == b.prim)
-                    .count();
-                *pct = Some(100.0 * same as f64 / ours.len().max(1) as f64);
-            }
-            out
-        }
-        #[cfg(not(feature = "tinybvh"))]
-        {
-            let _ = ours;
-            [None; 2]
-        }
-    }
-
     /// One timed pass of each: Mrays/s appended to its series.
-    fn round(&mut self, series: &mut [Vec<f64>; 2]) {
+    fn round(&mut self) {
         #[cfg(feature = "tinybvh")]
-        for (peer, figures) in self.built.iter_mut().zip(series.iter_mut()) {
-            figures.push(mrays(peer.rays(), peer.trace()));
+        for (peer, row) in &mut self.built {
+            row.mrays.push(mrays(peer.rays(), peer.trace()));
         }
+    }
+
+    /// The series and agreement of each.
+    fn into_rows(self) -> Vec<PrebuiltPeer> {
+        #[cfg(feature = "tinybvh")]
+        return self.built.into_iter().map(|(_, row)| row).collect();
         #[cfg(not(feature = "tinybvh"))]
-        let _ = series;
+        Vec::new()
     }
 }
 

@@ -44,14 +44,24 @@ pub enum Build {
 }
 
 impl Build {
-    /// Both, in the order of `crate::rounds::TINYBVH8_BUILDS`.
+    /// Both, in the order the rounds trace them.
     pub const ALL: [Self; 2] = [Self::Sah, Self::Spatial];
+
+    /// The report's name for the peer built this way.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Sah => "tinybvh 1.6 BVH8",
+            Self::Spatial => "tinybvh 1.6 BVH8 HQ",
+        }
+    }
 }
 
 /// A built `BVH8_CPU` with its rays (set once, outside the timing) and the hits of the last
 /// pass.
 pub struct TinyBvh8 {
     raw: NonNull<c_void>,
+    build: Build,
     t: Vec<f32>,
     prim: Vec<u32>,
 }
@@ -70,6 +80,7 @@ impl TinyBvh8 {
             unsafe { ffi::rkb_tiny8_new(flat.as_ptr(), count, i32::from(build == Build::Spatial)) };
         let bvh = Self {
             raw: NonNull::new(raw)?,
+            build,
             t: vec![0.0; records.len()],
             prim: vec![0; records.len()],
         };
@@ -102,6 +113,12 @@ impl TinyBvh8 {
             )
         };
         millis(start)
+    }
+
+    /// How it was built.
+    #[must_use]
+    pub fn build(&self) -> Build {
+        self.build
     }
 
     /// Rays per pass.
