@@ -724,18 +724,13 @@ fn rounds_section(s: &mut String, r: &BenchResults) {
             for (name, pairing) in pairs {
                 let Some(p) = pairing else { continue };
                 any = true;
-                let (lo, hi) = p.ratio_range();
                 let _ = writeln!(
                     s,
-                    "| {} | {} | {}{mark} {name} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2}× ({lo:.2}–{hi:.2}) |",
+                    "| {} | {} | {}{mark} {name} | {} |",
                     x.scene,
                     x.rays.name(),
                     ours.structure,
-                    p.ours_median,
-                    p.ours_best,
-                    p.peer_median,
-                    p.peer_best,
-                    p.median_ratio(),
+                    pairing_cells(&p),
                 );
             }
             if !any {
@@ -781,22 +776,31 @@ fn tinybvh8_table(s: &mut String, r: &BenchResults) {
          |---|---|---|---:|---:|---:|---:|---:|---:|"
     );
     for (x, t, p) in rows {
-        let (lo, hi) = p.ratio_range();
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2}× ({lo:.2}–{hi:.2}) | {:.3}% |",
+            "| {} | {} | {} | {} | {:.3}% |",
             x.scene,
             x.rays.name(),
             t.name,
-            p.ours_median,
-            p.ours_best,
-            p.peer_median,
-            p.peer_best,
-            p.median_ratio(),
+            pairing_cells(&p),
             t.same_prim_pct,
         );
     }
     let _ = writeln!(s);
+}
+
+/// A pairing's table cells: each side's median and best round, then the median per-round
+/// ratio with its range.
+fn pairing_cells(p: &Pairing) -> String {
+    let (lo, hi) = p.ratio_range();
+    format!(
+        "{:.2} | {:.2} | {:.2} | {:.2} | {:.2}× ({lo:.2}–{hi:.2})",
+        p.ours_median,
+        p.ours_best,
+        p.peer_median,
+        p.peer_best,
+        p.median_ratio()
+    )
 }
 
 fn ours_section(s: &mut String, r: &BenchResults) {
