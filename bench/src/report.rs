@@ -716,8 +716,10 @@ fn rounds_section(s: &mut String, r: &BenchResults) {
             // tinybvh's 8-wide BVH against the headline only.
             if fastest == Some(ours.structure) {
                 pairs.extend(x.tinybvh8.iter().map(|t| {
-                    let pairing = Pairing::of(&ours.prebuilt_mrays, &t.mrays);
-                    (format!("pre-built ÷ {}", t.name), pairing)
+                    (
+                        format!("pre-built ÷ {}", t.name),
+                        x.vs_prebuilt_peer(ours, t),
+                    )
                 }));
             }
             let mut any = false;

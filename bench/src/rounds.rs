@@ -163,6 +163,12 @@ impl RoundsRow {
         Pairing::of(&ours.prebuilt_mrays, &self.tinybvh_mrays)
     }
 
+    /// `ours` against `peer`, both on pre-built rays.
+    #[must_use]
+    pub fn vs_prebuilt_peer(&self, ours: &OursRounds, peer: &PrebuiltPeer) -> Option<Pairing> {
+        Pairing::of(&ours.prebuilt_mrays, &peer.mrays)
+    }
+
     /// `peer` (pre-built) against Embree HIGH per ray (`None` without Embree): how near the
     /// issue's reference for a wide SIMD BVH comes to Embree.
     #[must_use]
@@ -308,11 +314,14 @@ impl Alternate<'_> {
         };
         let coherent = Coherent(second);
         // The triangles as tinybvh's peers take them (none without peers).
-        let tris: Vec<[[f32; 3]; 3]> = (0..self.scene.mesh.triangle_count())
-            .filter(|_| self.with_peers)
-            .map(|i| self.scene.mesh.triangle_f32(i))
-            .collect();
-        let mut tinybvh8 = TinyBvh8Peers::new(&tris, &self.set.records, || {
+        let tris: Vec<[[f32; 3]; 3]> = if self.with_peers {
+            (0..self.scene.mesh.triangle_count())
+                .map(|i| self.scene.mesh.triangle_f32(i))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let mut tinybvh8 = TinyBvh8Peers::new(self.with_peers, &tris, &self.set.records, || {
             trace_closest_per_ray(second, &self.set.records).0
         });
         let mut round = |figures: &mut Figures| {
@@ -363,9 +372,10 @@ struct TinyBvh8Peers {
 }
 
 impl TinyBvh8Peers {
-    /// Every build over `tris` (none if empty), its rays set from `records`, each traced once
-    /// untimed against the hits `ours` gives (asked for only if something was built).
+    /// Every build over `tris` (none without peers), its rays set from `records`, each traced
+    /// once untimed against the hits `ours` gives (asked for only if something was built).
     fn new(
+        with_peers: bool,
         tris: &[[[f32; 3]; 3]],
         records: &[RayRecord],
         ours: impl FnOnce() -> Vec<HitRecord>,
@@ -373,11 +383,14 @@ impl TinyBvh8Peers {
         #[cfg(feature = "tinybvh")]
         {
             use crate::tinybvh8::{Build, TinyBvh8};
-            let peers: Vec<TinyBvh8> = Build::ALL
-                .iter()
-                .filter(|_| !tris.is_empty())
-                .filter_map(|&b| TinyBvh8::new(tris, records, b))
-                .collect();
+            let peers: Vec<TinyBvh8> = if with_peers {
+                Build::ALL
+                    .iter()
+                    .filter_map(|&b| TinyBvh8::new(tris, records, b))
+                    .collect()
+            } else {
+                Vec::new()
+            };
             let ours = if peers.is_empty() { Vec::new() } else { ours() };
             let built = peers
                 .into_iter()
@@ -397,7 +410,7 @@ impl TinyBvh8Peers {
         }
         #[cfg(not(feature = "tinybvh"))]
         {
-            let _ = (tris, records, ours);
+            let _ = (with_peers, tris, records, ours);
             Self {}
         }
     }
